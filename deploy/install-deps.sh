@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs every build, runtime and test dependency of fieldbridge from Debian 12
+# packages. Idempotent: packages already present are left alone, and apt is only
+# asked when something is missing. Needs root (or sudo) when it has to install.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake g++ pkg-config
+  # libraries (docs/dependencies.md says why each one is here)
+  libmodbus-dev libpaho-mqttpp-dev libpaho-mqtt-dev libssl-dev libyaml-cpp-dev
+  libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
+  libcli11-dev
+  # test and demo tools
+  socat mosquitto mosquitto-clients mbpoll python3 python3-pymodbus procps
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "install-deps: missing packages (${missing[*]}) and not root; run as root or install sudo" >&2
+    exit 1
+  fi
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The Debian mosquitto package starts a system broker on port 1883; tests and the
+# demo start their own broker on a private loopback port, so the system one is
+# not needed and is left as the package set it up.

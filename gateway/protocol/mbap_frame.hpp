@@ -1,0 +1,33 @@
+#pragma once
+/// @file mbap_frame.hpp
+/// Modbus TCP MBAP framing (Modbus Messaging on TCP/IP V1.0b, 3.1.3):
+/// transaction id, protocol id 0, length (unit id + PDU), unit id, PDU.
+
+#include <cstdint>
+
+#include "protocol/bytes.hpp"
+#include "protocol/decode_result.hpp"
+
+namespace fieldbridge::protocol {
+
+inline constexpr std::size_t mbap_header_size = 7;
+/// Length field covers unit id + PDU: at least 2 (unit + function), at most 254.
+inline constexpr std::uint16_t mbap_min_length = 2;
+inline constexpr std::uint16_t mbap_max_length = 254;
+
+struct MbapFrame {
+    std::uint16_t transaction_id = 0;
+    std::uint8_t unit_id = 0;
+    Bytes pdu;
+    bool operator==(const MbapFrame&) const = default;
+};
+
+[[nodiscard]] Bytes encode_mbap(std::uint16_t transaction_id, std::uint8_t unit_id, ByteView pdu);
+
+/// Frames the first MBAP frame in a TCP byte stream. need_more until the header
+/// and the announced length are there; malformed (bad_protocol_id, bad_length,
+/// oversize) as soon as the header shows it, since the stream cannot resynchronise
+/// (the server closes that connection).
+[[nodiscard]] DecodeResult<MbapFrame> decode_mbap(ByteView stream);
+
+}  // namespace fieldbridge::protocol

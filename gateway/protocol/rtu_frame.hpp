@@ -1,0 +1,51 @@
+#pragma once
+/// @file rtu_frame.hpp
+/// Modbus-RTU ADU framing: address + PDU + CRC-16 (low byte first, Modbus over
+/// Serial Line V1.02, 2.5.1.2). Frames are delimited by the length predicted from
+/// the function code; silence timers are only the resynchronisation backstop.
+
+#include <cstdint>
+
+#include "protocol/bytes.hpp"
+#include "protocol/decode_result.hpp"
+#include "protocol/modbus_pdu.hpp"
+
+namespace fieldbridge::protocol {
+
+inline constexpr std::size_t max_rtu_adu_size = 256;
+inline constexpr std::uint8_t modbus_broadcast_address = 0;
+inline constexpr std::uint8_t excd_broadcast_address = 0xFF;
+
+struct RtuFrame {
+    std::uint8_t address = 0;
+    Bytes pdu;
+    bool operator==(const RtuFrame&) const = default;
+};
+
+/// address + pdu + CRC.
+[[nodiscard]] Bytes encode_rtu(std::uint8_t address, ByteView pdu);
+
+/// Decodes one exact ADU (length known from outside): CRC checked, at least 4 bytes.
+[[nodiscard]] DecodeResult<RtuFrame> decode_rtu(ByteView adu);
+
+/// Frames a reply in a receive buffer that may begin with garbage or local echo.
+/// Expected: from @p address, answering @p request (a decoded request PDU).
+/// - need_more: a plausible reply is still arriving;
+/// - complete: `consumed` = bytes up to the end of the reply (including skipped garbage);
+/// - malformed: drop `consumed` bytes and call again (error says why: bad_crc,
+///   wrong_address, wrong_function...).
+/// Opaque requests are framed by scanning for the shortest prefix whose CRC verifies.
+[[nodiscard]] DecodeResult<RtuFrame> frame_rtu_response(ByteView rx, std::uint8_t address,
+                                                        const Request& request);
+
+/// Frames a request (server / simulator side) by the length predicted from its
+/// function code; for unknown function codes, by the shortest CRC-valid prefix.
+[[nodiscard]] DecodeResult<RtuFrame> frame_rtu_request(ByteView rx);
+
+/// Characters on the wire for @p bytes at 8N1/8E1 etc: 11 bits a byte with parity
+/// or 2 stop bits, 10 otherwise (Modbus over Serial Line, 2.5.1).
+[[nodiscard]] constexpr unsigned bits_per_character(bool parity, unsigned stop_bits) noexcept {
+    return 1 + 8 + (parity ? 1u : 0u) + stop_bits;
+}
+
+}  // namespace fieldbridge::protocol
