@@ -1,0 +1,2 @@
+// implementation follows
+#include "protocol/crc16.hpp"

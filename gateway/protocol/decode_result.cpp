@@ -1,0 +1,2 @@
+// implementation follows
+#include "protocol/decode_result.hpp"

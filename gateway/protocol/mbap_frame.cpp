@@ -1,0 +1,2 @@
+// implementation follows
+#include "protocol/mbap_frame.hpp"

@@ -1,0 +1,2 @@
+// implementation follows
+#include "protocol/modbus_pdu.hpp"

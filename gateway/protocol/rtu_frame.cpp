@@ -1,0 +1,2 @@
+// implementation follows
+#include "protocol/rtu_frame.hpp"

@@ -1,0 +1,2 @@
+// implementation follows
+#include "protocol/wtec_ascii_frame.hpp"
