@@ -1,0 +1,62 @@
+#pragma once
+/// @file serial_port.hpp
+/// The seam around a serial port. A line worker owns exactly one SerialPort; tests
+/// inject a fake. Reads and writes are non-blocking: the worker waits for
+/// readiness on native_handle() in its event loop.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+#include "protocol/bytes.hpp"
+
+namespace fieldbridge::engine {
+
+/// The port could not be opened or vanished (USB adapter unplugged, pty closed).
+/// what() says which port, what failed and what to check.
+class SerialPortError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct SerialSettings {
+    std::string path;
+    unsigned baud = 115200;
+    char parity = 'N';  ///< 'N', 'E' or 'O'
+    unsigned data_bits = 8;
+    unsigned stop_bits = 1;
+    /// Kernel RS-485 mode (TIOCSRS485): the driver switches the transceiver.
+    bool rs485 = false;
+    bool rts_on_send = true;
+    bool rts_after_send = false;
+    unsigned delay_rts_before_send_ms = 0;
+    unsigned delay_rts_after_send_ms = 0;
+};
+
+class SerialPort {
+public:
+    SerialPort() = default;
+    virtual ~SerialPort() = default;
+    SerialPort(const SerialPort&) = delete;
+    SerialPort& operator=(const SerialPort&) = delete;
+
+    /// Opens and configures the port. Throws SerialPortError.
+    virtual void open() = 0;
+    virtual void close() noexcept = 0;
+    [[nodiscard]] virtual bool is_open() const noexcept = 0;
+    /// File descriptor to wait on for readiness; -1 when closed.
+    [[nodiscard]] virtual int native_handle() const noexcept = 0;
+    /// Writes what the driver accepts now; returns the count (0 when it would block).
+    /// Throws SerialPortError when the port is gone.
+    [[nodiscard]] virtual std::size_t write_some(protocol::ByteView bytes) = 0;
+    /// Reads what is available now; returns the count (0 when nothing is there).
+    /// Throws SerialPortError when the port is gone.
+    [[nodiscard]] virtual std::size_t read_some(std::span<std::uint8_t> buffer) = 0;
+    /// Drops whatever is in the driver's input buffer (resynchronisation).
+    virtual void discard_input() noexcept = 0;
+    [[nodiscard]] virtual const SerialSettings& settings() const noexcept = 0;
+};
+
+}  // namespace fieldbridge::engine
