@@ -1,0 +1,223 @@
+#include "config/build_config.hpp"
+
+#include <fstream>
+#include <iterator>
+
+#include "config/validate.hpp"
+
+namespace fieldbridge::config {
+
+namespace {
+
+template <class To>
+[[nodiscard]] To narrow(const Field<std::int64_t>& field, To fallback) {
+    return field.has_value() ? static_cast<To>(*field) : fallback;
+}
+
+template <class T>
+void set(T& target, const Field<T>& field) {
+    if (field.has_value()) {
+        target = *field;
+    }
+}
+
+[[nodiscard]] Backoff build_backoff(const RawBackoff& raw, Backoff defaults) {
+    set(defaults.initial, raw.initial);
+    set(defaults.max, raw.max);
+    return defaults;
+}
+
+[[nodiscard]] std::string resolved_file(const Field<std::string>& field, const std::filesystem::path& base_dir) {
+    if (!field.has_value() || field->empty()) {
+        return {};
+    }
+    return resolve_path(base_dir, *field).string();
+}
+
+[[nodiscard]] ModbusTcpConfig build_modbus_tcp(const RawModbusTcp& raw) {
+    ModbusTcpConfig tcp;
+    if (raw.listen.ok()) {
+        tcp.listen.clear();
+        for (const auto& item : raw.listen.items) {
+            tcp.listen.push_back(*item);
+        }
+    }
+    tcp.max_connections = narrow<std::size_t>(raw.max_connections, tcp.max_connections);
+    set(tcp.idle_timeout, raw.idle_timeout);
+    for (const auto& item : raw.allow.items) {
+        tcp.allow.push_back(*item);
+    }
+    for (const auto& raw_rule : raw.rules.items) {
+        AccessRule rule;
+        for (const auto& c : raw_rule.clients.items) {
+            rule.clients.push_back(*c);
+        }
+        for (const auto& u : raw_rule.units.items) {
+            rule.units.push_back(static_cast<std::uint8_t>(*u));
+        }
+        for (const auto& f : raw_rule.functions.items) {
+            rule.functions.push_back(static_cast<std::uint8_t>(*f));
+        }
+        if (raw_rule.registers.ok()) {
+            rule.registers = RegisterRange{static_cast<std::uint16_t>(*raw_rule.registers.from),
+                                           static_cast<std::uint16_t>(*raw_rule.registers.to)};
+        }
+        rule.action = *raw_rule.action;
+        tcp.rules.push_back(std::move(rule));
+    }
+    return tcp;
+}
+
+[[nodiscard]] DeviceConfig build_device(const RawDevice& raw) {
+    DeviceConfig device;
+    device.name = *raw.name;
+    device.type = *raw.type;
+    device.address = static_cast<std::uint8_t>(*raw.address);
+    device.unit_id = static_cast<std::uint8_t>(*raw.unit_id);
+    set(device.max_age, raw.max_age);
+    set(device.command_ttl, raw.command_ttl);
+    set(device.delay_before_command, raw.delay_before_command);
+    device.queue_limit = narrow<std::size_t>(raw.queue_limit, device.queue_limit);
+    set(device.poll.fast, raw.poll.fast);
+    set(device.poll.slow, raw.poll.slow);
+    set(device.poll.motion, raw.poll.motion);
+    set(device.allow_protected, raw.allow_protected);
+    set(device.mqtt_commands, raw.mqtt_commands);
+    set(device.word_order, raw.word_order);
+    if (raw.stroke.has_value()) {
+        device.stroke = static_cast<std::uint32_t>(*raw.stroke);
+    }
+    for (const auto& raw_block : raw.blocks.items) {
+        RegisterBlock block;
+        block.table = *raw_block.table;
+        block.address = static_cast<std::uint16_t>(*raw_block.address);
+        block.count = static_cast<std::uint16_t>(*raw_block.count);
+        set(block.period, raw_block.period);
+        set(block.writable, raw_block.writable);
+        device.blocks.push_back(block);
+    }
+    return device;
+}
+
+[[nodiscard]] LineConfig build_line(const RawLine& raw) {
+    LineConfig line = framing_of(raw);  // name-less framing with defaults; validated values are in range
+    line.name = *raw.name;
+    line.port = *raw.port;
+    set(line.rs485.enabled, raw.rs485.enabled);
+    set(line.rs485.rts_on_send, raw.rs485.rts_on_send);
+    set(line.rs485.rts_after_send, raw.rs485.rts_after_send);
+    set(line.rs485.delay_before_send, raw.rs485.delay_before_send);
+    set(line.rs485.delay_after_send, raw.rs485.delay_after_send);
+    set(line.local_echo, raw.local_echo);
+    set(line.response_timeout, raw.response_timeout);
+    line.byte_timeout = raw.byte_timeout.value_or(default_byte_timeout(line));
+    set(line.turnaround, raw.turnaround);
+    line.read_retries = narrow<unsigned>(raw.read_retries, line.read_retries);
+    line.offline_after = narrow<unsigned>(raw.offline_after, line.offline_after);
+    line.offline_backoff = build_backoff(raw.offline_backoff, line.offline_backoff);
+    if (raw.broadcast_unit.has_value()) {
+        line.broadcast_unit = static_cast<std::uint8_t>(*raw.broadcast_unit);
+    }
+    for (const auto& device : raw.devices.items) {
+        line.devices.push_back(build_device(device));
+    }
+    return line;
+}
+
+[[nodiscard]] UpstreamConfig build_upstream(const RawUpstream& raw) {
+    UpstreamConfig upstream;
+    upstream.name = *raw.name;
+    upstream.host = *raw.host;
+    upstream.port = narrow<std::uint16_t>(raw.port, upstream.port);
+    set(upstream.connect_timeout, raw.connect_timeout);
+    set(upstream.response_timeout, raw.response_timeout);
+    upstream.reconnect_backoff = build_backoff(raw.reconnect_backoff, upstream.reconnect_backoff);
+    set(upstream.poll_period, raw.poll_period);
+    set(upstream.command_ttl, raw.command_ttl);
+    upstream.queue_limit = narrow<std::size_t>(raw.queue_limit, upstream.queue_limit);
+    for (const auto& raw_unit : raw.units.items) {
+        UpstreamUnitConfig unit;
+        unit.unit_id = static_cast<std::uint8_t>(*raw_unit.unit_id);
+        unit.upstream_unit = narrow<std::uint8_t>(raw_unit.upstream_unit, unit.upstream_unit);
+        unit.name = *raw_unit.name;
+        upstream.units.push_back(std::move(unit));
+    }
+    return upstream;
+}
+
+[[nodiscard]] MqttConfig build_mqtt(const RawMqtt& raw, const std::string& gateway_id,
+                                    const std::filesystem::path& base_dir, DiagnosticSink& sink) {
+    MqttConfig mqtt;
+    mqtt.enabled = raw.ok() && raw.enabled.value_or(true);
+    set(mqtt.uri, raw.uri);
+    mqtt.client_id = raw.client_id.value_or("");
+    if (mqtt.client_id.empty()) {
+        mqtt.client_id = "fieldbridge-" + gateway_id;
+    }
+    set(mqtt.username, raw.username);
+    set(mqtt.password, raw.password);
+    mqtt.password_file = resolved_file(raw.password_file, base_dir);
+    if (!mqtt.password_file.empty()) {
+        std::ifstream in(mqtt.password_file, std::ios::binary);
+        if (!in) {
+            sink.error(raw.password_file, "cannot read " + mqtt.password_file +
+                                              "; check that the service user may read it");
+        }
+        std::string secret((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        // One trailing newline is what `echo secret > file` leaves: it is not part of
+        // the password.
+        if (!secret.empty() && secret.back() == '\n') {
+            secret.pop_back();
+            if (!secret.empty() && secret.back() == '\r') {
+                secret.pop_back();
+            }
+        }
+        mqtt.password = std::move(secret);
+    }
+    mqtt.tls.ca_file = resolved_file(raw.tls.ca_file, base_dir);
+    mqtt.tls.cert_file = resolved_file(raw.tls.cert_file, base_dir);
+    mqtt.tls.key_file = resolved_file(raw.tls.key_file, base_dir);
+    set(mqtt.tls.verify, raw.tls.verify);
+    mqtt.qos = static_cast<int>(raw.qos.value_or(mqtt.qos));
+    set(mqtt.keep_alive, raw.keep_alive);
+    set(mqtt.clean_session, raw.clean_session);
+    set(mqtt.version, raw.version);
+    mqtt.prefix = raw.prefix.value_or("");
+    if (mqtt.prefix.empty()) {
+        mqtt.prefix = "fieldbridge/" + gateway_id;
+    }
+    set(mqtt.heartbeat, raw.heartbeat);
+    set(mqtt.min_interval, raw.min_interval);
+    for (const auto& [name, threshold] : raw.deadband.entries) {
+        mqtt.deadband[*name] = *threshold;
+    }
+    set(mqtt.diag_period, raw.diag_period);
+    mqtt.reconnect_backoff = build_backoff(raw.reconnect_backoff, mqtt.reconnect_backoff);
+    return mqtt;
+}
+
+}  // namespace
+
+Config build_config(const RawConfig& raw, const std::filesystem::path& base_dir, std::string source_file,
+                    DiagnosticSink& sink) {
+    Config config;
+    config.source_file = std::move(source_file);
+    config.gateway.id = *raw.gateway.id;
+    set(config.gateway.log_level, raw.gateway.log_level);
+    config.modbus_tcp = build_modbus_tcp(raw.modbus_tcp);
+    for (const auto& line : raw.lines.items) {
+        config.lines.push_back(build_line(line));
+    }
+    for (const auto& upstream : raw.upstreams.items) {
+        config.upstreams.push_back(build_upstream(upstream));
+    }
+    config.mqtt = build_mqtt(raw.mqtt, config.gateway.id, base_dir, sink);
+    if (raw.metrics_http.ok()) {
+        MetricsHttpConfig metrics;
+        set(metrics.listen, raw.metrics_http.listen);
+        config.metrics_http = metrics;
+    }
+    return config;
+}
+
+}  // namespace fieldbridge::config
