@@ -22,12 +22,14 @@ struct MbapFrame {
     bool operator==(const MbapFrame&) const = default;
 };
 
+/// Throws std::invalid_argument for an empty PDU or one longer than 253 bytes.
 [[nodiscard]] Bytes encode_mbap(std::uint16_t transaction_id, std::uint8_t unit_id, ByteView pdu);
 
 /// Frames the first MBAP frame in a TCP byte stream. need_more until the header
 /// and the announced length are there; malformed (bad_protocol_id, bad_length,
 /// oversize) as soon as the header shows it, since the stream cannot resynchronise
-/// (the server closes that connection).
+/// (the server closes that connection). On malformed, `consumed` is the whole input.
+/// Complete: `consumed` = 6 + length; bytes after it belong to the next frame.
 [[nodiscard]] DecodeResult<MbapFrame> decode_mbap(ByteView stream);
 
 }  // namespace fieldbridge::protocol

@@ -165,6 +165,11 @@ using Response = std::variant<ReadBitsResponse, ReadRegistersResponse, WriteSing
 // ---- codec ----------------------------------------------------------------------
 
 [[nodiscard]] std::uint8_t function_of(const Request& request) noexcept;
+
+/// False only for the function codes the Modbus specification defines as reads
+/// (01, 02, 03, 04, 07, 0B, 0C, 11, 14, 18, 2B); every other code, unknown ones
+/// included, may change the device and counts as a write (never auto-retried).
+/// The exception flag 0x80 is ignored.
 [[nodiscard]] bool is_write(std::uint8_t function) noexcept;
 
 /// Encodes a request PDU. Throws std::invalid_argument when the request breaks a
@@ -174,14 +179,29 @@ using Response = std::variant<ReadBitsResponse, ReadRegistersResponse, WriteSing
 /// Decodes one complete request PDU (exact length). A PDU shorter or longer than
 /// its function code implies, a count of 0 or above the limit, a byte count that
 /// disagrees with the count: malformed (bad_length / bad_value).
+/// Exact-length decoder: never need_more; on malformed, `consumed` is the whole input.
+/// bad_length: empty, or size / byte count inconsistent; oversize: above max_pdu_size;
+/// bad_value: function code 0 or >= 0x80, quantity 0 or above the limit, FC05 value
+/// other than 0xFF00 / 0x0000. Unknown function codes decode as OpaqueRequest.
 [[nodiscard]] DecodeResult<Request> decode_request(ByteView pdu);
 
+/// Encodes a response PDU. Throws std::invalid_argument for a response no device
+/// may send (function code that does not fit the type, 0 or above the limit values).
 [[nodiscard]] Bytes encode_response(const Response& response);
+/// {function | 0x80, code}. Throws std::invalid_argument unless function is 1..127.
 [[nodiscard]] Bytes encode_exception(std::uint8_t function, ExceptionCode code);
 
 /// Decodes one complete response PDU (exact length) in answer to @p request: the
 /// function must match (or be the exception of it), the sizes must match what was
-/// asked (register count, echo of the write). Mismatch: malformed (unexpected_reply).
+/// asked (register count, echo of the write). Exact-length decoder: never need_more;
+/// on malformed, `consumed` is the whole input. Errors:
+/// - wrong_function: neither the request's function code nor its exception;
+/// - bad_length: empty, size inconsistent with the function or its own byte count
+///   (a read reply with byte count 0 included); oversize: above max_pdu_size;
+/// - unexpected_reply: well formed, but another quantity or another write echo.
+/// Read replies decode to ReadBitsResponse (byte_count * 8 bits) or
+/// ReadRegistersResponse; FC07 to ReadExceptionStatusResponse; exceptions (any code
+/// byte, carried as-is) to ExceptionResponse; replies to opaque requests to OpaqueResponse.
 [[nodiscard]] DecodeResult<Response> decode_response(ByteView pdu, const Request& request);
 
 /// Length of the request PDU starting at pdu[0] (the function code), predicted from
@@ -196,7 +216,9 @@ struct PredictedLength {
 
 /// Length of the response PDU to @p request starting at pdu[0]: an exception is
 /// always 2 bytes; a normal reply's length is known from the request (reads: byte
-/// count from the requested quantity; writes: fixed). nullopt for opaque requests.
+/// count from the requested quantity; writes: fixed). need_more for an empty prefix;
+/// status malformed when pdu[0] is neither the request's function code nor its
+/// exception; nullopt for a normal reply to an opaque request (only the device knows).
 [[nodiscard]] std::optional<PredictedLength> predict_response_pdu_length(ByteView pdu_prefix,
                                                                         const Request& request);
 

@@ -4,7 +4,14 @@
 /// (seed 003, "指令集": A $ a B b C D d E G g I i P p N n R r U W w Z).
 /// Field widths follow the manual's CRC-verified examples where the prose and the
 /// example disagree (vectors.yaml marks each such case). Replies are parsed
-/// strictly: exact data length per command, hex digits only.
+/// strictly: exact data length per command, hex digits only (upper case, see
+/// wtec_ascii_frame.hpp).
+///
+/// Encoders throw std::invalid_argument for a value the wire cannot carry (a
+/// one-digit field above 0xF, an `E` action outside 1-3, an `i` address outside
+/// 1-253, a reply type that does not answer the command). Decoders return values;
+/// `consumed` is 0 in their results because they take a frame scan_frame already
+/// took off the line.
 
 #include <cstdint>
 #include <optional>
@@ -62,6 +69,8 @@ struct Pid {
 };
 
 /// `W` reply / `w` request: 2+2 hex digits then 26 '0' (30 data characters).
+/// The 26 reserved characters are encoded as '0'; on decode they must be hex
+/// digits but may be any (the manual only calls them blank).
 struct ReleaseParams {
     std::uint8_t current = 0;
     std::uint8_t speed = 0;
@@ -135,14 +144,18 @@ using Command = std::variant<ReadVersion, ReadStations, SetMotorEnable, ReadHomi
 /// The request frame for @p command to @p address (ReadStations goes to address 0).
 [[nodiscard]] AsciiFrame encode_command(std::uint8_t address, const Command& command);
 
-/// Decodes a request frame (simulator side): letter known, data length and hex exact.
+/// Decodes a request frame (simulator side): letter known (else wrong_function),
+/// data length (bad_length) and hex digits (bad_hex) exact, `a` 0/1, `E` 1-3 and
+/// `i` 01-FD (else bad_value). The frame's address is left to the caller.
 [[nodiscard]] DecodeResult<Command> decode_command(const AsciiFrame& frame);
 
 // ---- replies (gripper -> host) --------------------------------------------------
 struct Ack { bool operator==(const Ack&) const = default; };  ///< reply with no data (a b C D E G i n p r U w Z)
 /// `E` answered by an echo of the request: the drive is not homed and did nothing.
 struct NotHomed { bool operator==(const NotHomed&) const = default; };
-struct Version { std::string text; bool operator==(const Version&) const = default; };  // A: 12 chars
+/// `A`: printable text of 12 (the manual's prose) or 13 characters (its CRC-verified
+/// example "Cstep [A]1.62").
+struct Version { std::string text; bool operator==(const Version&) const = default; };  // A
 struct Station { std::uint8_t address = 0; bool operator==(const Station&) const = default; };  // $
 struct StateCode { std::uint8_t code = 0; bool operator==(const StateCode&) const = default; };  // d, g
 
@@ -155,9 +168,11 @@ using Reply = std::variant<Ack, NotHomed, Version, Station, HomingParams, StateC
 [[nodiscard]] AsciiFrame encode_reply(std::uint8_t address, const Command& command, const Reply& reply);
 
 /// Decodes @p frame as the reply to @p command sent to @p address: the letter must
-/// match, the address must be the one asked (for `i`, the new one; for `$`, any),
-/// the data length and digits exact. Otherwise malformed (unexpected_reply,
-/// wrong_address, bad_length, bad_hex).
+/// match, the address must be the one asked (for `i`, the new one; for `$`, any
+/// device address 01-FD, repeated as the data), the data length and digits exact.
+/// Otherwise malformed: wrong_address (checked first), unexpected_reply (another
+/// letter, or an `E` echo of another action), bad_length, bad_hex, bad_value (an
+/// enable flag other than 0/1, a `$` station that differs from the frame address).
 [[nodiscard]] DecodeResult<Reply> decode_reply(std::uint8_t address, const Command& command,
                                                const AsciiFrame& frame);
 
