@@ -47,6 +47,7 @@ enum class OutcomeStatus : std::uint8_t {
     device_offline,  ///< the device is offline and already holds its one queued request
     cancelled,       ///< shut down or reconfigured before it was sent
     broadcast_sent,  ///< broadcast written and the silence observed; no reply expected
+    invalid_request, ///< cannot be carried (unknown device, unencodable request): never sent
 };
 
 [[nodiscard]] const char* to_string(OutcomeStatus status) noexcept;
@@ -74,6 +75,7 @@ struct Transaction {
     Duration delay_before{};          ///< per-device delay before a command (rule 11)
     TimePoint enqueued{};
     std::uint64_t id = 0;             ///< set by the scheduler, for logs
+    unsigned attempts = 0;            ///< times it went on the wire so far (set by the line master)
     std::function<void(const Outcome&)> on_done;
 };
 

@@ -1,0 +1,31 @@
+#pragma once
+/// @file line_log.hpp
+/// The log seam of the line engine: the scheduler and the line master report through
+/// an injected sink, never a global logger, so tests can capture and assert on it
+/// and the daemon can route it to spdlog / journald.
+
+#include <cstdint>
+#include <functional>
+#include <string_view>
+
+namespace fieldbridge::engine {
+
+enum class LogLevel : std::uint8_t { debug = 0, info = 1, warning = 2, error = 3 };
+
+[[nodiscard]] const char* to_string(LogLevel level) noexcept;
+
+/// Receives one finished message per call. Messages are only built when
+/// enabled(level) is true, so a debug transition log costs nothing when off.
+struct LogSink {
+    std::function<void(LogLevel, std::string_view)> write;
+    LogLevel min_level = LogLevel::info;
+
+    [[nodiscard]] bool enabled(LogLevel level) const noexcept {
+        return write && level >= min_level;
+    }
+    void operator()(LogLevel level, std::string_view message) const {
+        if (enabled(level)) write(level, message);
+    }
+};
+
+}  // namespace fieldbridge::engine

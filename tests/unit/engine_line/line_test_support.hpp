@@ -1,0 +1,163 @@
+#pragma once
+// Helpers for the line engine tests: a fake time base, transaction builders, reply
+// bytes, an on_done recorder and one-step drivers for the line master.
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "engine/line_master.hpp"
+#include "engine/line_scheduler.hpp"
+#include "engine/transaction.hpp"
+#include "protocol/modbus_pdu.hpp"
+#include "protocol/rtu_frame.hpp"
+#include "protocol/wtec_ascii_commands.hpp"
+#include "protocol/wtec_ascii_frame.hpp"
+
+namespace line_test {
+
+namespace fe = fieldbridge::engine;
+namespace fp = fieldbridge::protocol;
+namespace wtec = fieldbridge::protocol::wtec;
+using namespace std::chrono_literals;
+using fe::Duration;
+using fe::Priority;
+using fe::TimePoint;
+using fe::Transaction;
+using fp::Bytes;
+
+/// Fake time origin: far from the clock's epoch so "last activity = epoch" is old.
+inline const TimePoint t0 = TimePoint{} + std::chrono::hours{1};
+
+/// Counts on_done calls per tag and keeps the outcomes.
+class Recorder {
+public:
+    std::function<void(const fe::Outcome&)> done(const std::string& tag) {
+        return [this, tag](const fe::Outcome& outcome) {
+            outcomes_[tag].push_back(outcome);
+            order_.push_back(tag);
+        };
+    }
+    [[nodiscard]] std::size_t calls(const std::string& tag) const {
+        const auto it = outcomes_.find(tag);
+        return it == outcomes_.end() ? 0 : it->second.size();
+    }
+    /// The only outcome of @p tag (checks it was called exactly once).
+    [[nodiscard]] const fe::Outcome& outcome(const std::string& tag) const {
+        REQUIRE(calls(tag) == 1);
+        return outcomes_.at(tag).front();
+    }
+    [[nodiscard]] fe::OutcomeStatus status(const std::string& tag) const { return outcome(tag).status; }
+    [[nodiscard]] const std::vector<std::string>& order() const { return order_; }
+    [[nodiscard]] std::size_t total() const { return order_.size(); }
+
+private:
+    std::map<std::string, std::vector<fe::Outcome>> outcomes_;
+    std::vector<std::string> order_;
+};
+
+/// FC03/FC04 read of @p count registers at @p address.
+inline Transaction read_tx(fe::DeviceIndex device, std::uint8_t address, Priority priority,
+                           std::uint16_t reg = 0x0300, std::uint16_t count = 2,
+                           std::uint8_t function = fp::fc::read_input_registers) {
+    Transaction t;
+    t.device = device;
+    t.address = address;
+    t.payload = fe::ModbusPayload{fp::ReadRegistersRequest{function, reg, count}};
+    t.priority = priority;
+    t.retry_allowed = true;
+    return t;
+}
+
+/// FC06 command.
+inline Transaction write_tx(fe::DeviceIndex device, std::uint8_t address, std::uint16_t reg,
+                            std::uint16_t value) {
+    Transaction t;
+    t.device = device;
+    t.address = address;
+    t.payload = fe::ModbusPayload{fp::WriteSingleRegisterRequest{reg, value}};
+    t.priority = Priority::command;
+    return t;
+}
+
+inline Transaction ascii_tx(fe::DeviceIndex device, std::uint8_t address, wtec::Command command,
+                            Priority priority = Priority::poll) {
+    Transaction t;
+    t.device = device;
+    t.address = address;
+    t.payload = fe::AsciiPayload{std::move(command)};
+    t.priority = priority;
+    return t;
+}
+
+inline Transaction tagged(Transaction t, Recorder& recorder, const std::string& tag) {
+    t.on_done = recorder.done(tag);
+    return t;
+}
+
+inline Bytes rtu(std::uint8_t address, const Bytes& pdu) { return fp::encode_rtu(address, pdu); }
+
+inline Bytes read_reply(std::uint8_t address, std::vector<std::uint16_t> values,
+                        std::uint8_t function = fp::fc::read_input_registers) {
+    return rtu(address, fp::encode_response(fp::ReadRegistersResponse{function, std::move(values)}));
+}
+
+inline Bytes text_bytes(const std::string& text) { return Bytes(text.begin(), text.end()); }
+
+inline Bytes ascii_frame(std::uint8_t address, char command, std::string data) {
+    return text_bytes(wtec::encode_frame(wtec::AsciiFrame{address, command, std::move(data)}));
+}
+
+inline Bytes concat(std::initializer_list<Bytes> parts) {
+    Bytes out;
+    for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+    return out;
+}
+
+// ---- master drivers -------------------------------------------------------------
+
+inline TimePoint expect_wait(fe::LineMaster& master, TimePoint now) {
+    auto action = master.next_action(now);
+    REQUIRE(std::holds_alternative<fe::line_action::Wait>(action));
+    return std::get<fe::line_action::Wait>(action).until;
+}
+
+inline Bytes expect_write(fe::LineMaster& master, TimePoint now) {
+    auto action = master.next_action(now);
+    REQUIRE(std::holds_alternative<fe::line_action::Write>(action));
+    const auto view = std::get<fe::line_action::Write>(action).bytes;
+    return Bytes(view.begin(), view.end());
+}
+
+inline fe::line_action::Finished expect_finished(fe::LineMaster& master, TimePoint now) {
+    auto action = master.next_action(now);
+    REQUIRE(std::holds_alternative<fe::line_action::Finished>(action));
+    return std::move(std::get<fe::line_action::Finished>(action));
+}
+
+/// Starts @p t at @p now, waits for the silence, writes at the earliest moment.
+/// Returns the request bytes; the write time is in @p written_at.
+inline Bytes send(fe::LineMaster& master, Transaction t, TimePoint now, TimePoint& written_at) {
+    master.start(std::move(t), now);
+    auto action = master.next_action(now);
+    if (std::holds_alternative<fe::line_action::Wait>(action)) {
+        now = std::get<fe::line_action::Wait>(action).until;
+        action = master.next_action(now);
+    }
+    REQUIRE(std::holds_alternative<fe::line_action::Write>(action));
+    const auto view = std::get<fe::line_action::Write>(action).bytes;
+    Bytes bytes(view.begin(), view.end());
+    master.on_written(now);
+    written_at = now;
+    return bytes;
+}
+
+/// The 115200 8N1 configuration of the product's devices with the config defaults.
+inline fe::LineTimingConfig default_line() { return fe::LineTimingConfig{}; }
+
+}  // namespace line_test

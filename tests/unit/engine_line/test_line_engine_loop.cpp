@@ -1,0 +1,269 @@
+// The scheduler and the line master driven together, as the line worker will drive
+// them, over a simulated bus in virtual time: three live devices with injected faults
+// (lost replies, noise, CRC errors, split replies), one dead device, polls, on-demand
+// reads, commands and a broadcast. Invariants: every on_done exactly once, never a
+// request before t3.5 of silence, a command goes at the very next start, the dead
+// device is probed with back-off and never holds more than one request.
+#include <doctest/doctest.h>
+
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "line_test_support.hpp"
+
+namespace {
+
+using namespace line_test;
+using fe::OutcomeStatus;
+
+constexpr std::uint8_t dead_address = 9;
+
+fe::LineTimingConfig short_timeouts() {
+    fe::LineTimingConfig config = default_line();
+    config.response_timeout = 20ms;
+    return config;
+}
+
+struct Simulation {
+    fe::LineTimingConfig line = short_timeouts();
+    fe::LineMaster master{"A", line};
+    fe::LineScheduler scheduler{fe::SchedulerConfig{"A"}};
+    std::mt19937 rng{20240601};
+    std::multimap<TimePoint, Bytes> rx;  // bytes the bus delivers, by time
+    TimePoint now = t0;
+    TimePoint last_wire = t0;  // end of the last byte on the wire, as the bus saw it
+
+    // Bookkeeping.
+    std::map<std::uint64_t, int> done_calls;  // by submission number
+    std::map<std::uint64_t, OutcomeStatus> final_status;
+    std::uint64_t submitted = 0;
+    std::uint64_t writes = 0;
+    std::uint64_t early_writes = 0;
+    std::uint64_t starts = 0;
+    std::optional<std::uint64_t> command_waiting;  // submission number of the queued command
+    std::uint64_t commands_not_next = 0;
+    std::uint64_t commands_started = 0;
+    std::vector<TimePoint> dead_writes;
+    std::size_t max_dead_queue = 0;
+    std::map<fe::DeviceIndex, bool> poll_outstanding;
+
+    Simulation() {
+        master.reset(t0);
+        fe::DeviceLimits limits;
+        limits.read_retries = 1;
+        limits.offline_after = 3;
+        limits.backoff_initial = 100ms;
+        limits.backoff_max = 400ms;
+        for (fe::DeviceIndex d = 0; d < 4; ++d) scheduler.add_device(d, limits);
+    }
+
+    static std::uint8_t address_of(fe::DeviceIndex d) {
+        return d == 3 ? dead_address : static_cast<std::uint8_t>(d + 1);
+    }
+
+    void submit(Transaction t, std::function<void(OutcomeStatus)> also = {}) {
+        const std::uint64_t number = submitted++;
+        done_calls[number] = 0;
+        t.on_done = [this, number, also](const fe::Outcome& outcome) {
+            ++done_calls[number];
+            final_status[number] = outcome.status;
+            if (also) also(outcome.status);
+        };
+        scheduler.submit(std::move(t), now);
+    }
+
+    void submit_poll(fe::DeviceIndex d) {
+        if (poll_outstanding[d]) return;
+        poll_outstanding[d] = true;
+        auto t = read_tx(d, address_of(d), Priority::poll, 0x0300, 2);
+        t.poll_period = 20ms;
+        submit(std::move(t), [this, d](OutcomeStatus) { poll_outstanding[d] = false; });
+    }
+
+    void submit_command(fe::DeviceIndex d) {
+        if (command_waiting || scheduler.queued() == 0) return;  // one at a time, behind others
+        auto t = write_tx(d, address_of(d), 0x0601, 1);
+        t.deadline = now + 500ms;
+        const std::uint64_t number = submitted;
+        command_waiting = number;
+        submit(std::move(t), [this, number](OutcomeStatus) {
+            if (command_waiting == number) command_waiting.reset();  // refused at once
+        });
+    }
+
+    /// The device model: the reply bytes for a request, with faults.
+    void answer(const Bytes& request, TimePoint tx_end) {
+        const auto framed = fp::frame_rtu_request(request);
+        REQUIRE(framed.complete());
+        if (framed.value.address == dead_address || framed.value.address == 0) return;
+        const auto decoded = fp::decode_request(framed.value.pdu);
+        REQUIRE(decoded.complete());
+        Bytes reply;
+        if (const auto* read = std::get_if<fp::ReadRegistersRequest>(&decoded.value)) {
+            reply = read_reply(framed.value.address, std::vector<std::uint16_t>(read->count, 0x1234),
+                               read->function);
+        } else {
+            const auto& write = std::get<fp::WriteSingleRegisterRequest>(decoded.value);
+            reply = rtu(framed.value.address,
+                        fp::encode_response(fp::WriteSingleResponse{0x06, write.address, write.value}));
+        }
+        const TimePoint start = tx_end + 1ms;  // device turnaround
+        const auto wire = [this](std::size_t n) { return master.timing().wire_time(n); };
+        const auto fault = static_cast<unsigned>(rng() % 100);
+        if (fault < 3) return;  // lost
+        if (fault < 13) {       // noise glued to the front
+            Bytes noisy = concat({Bytes{0x00}, reply});
+            rx.emplace(start + wire(noisy.size()), noisy);
+        } else if (fault < 18) {  // a corrupted copy, then a good one
+            Bytes bad = reply;
+            bad[bad.size() - 3] ^= 0x40;  // a data bit: only the CRC can tell
+            rx.emplace(start + wire(bad.size()), bad);
+            rx.emplace(start + 2ms + wire(reply.size()), reply);
+        } else if (fault < 25) {  // one byte per read
+            for (std::size_t i = 0; i < reply.size(); ++i) rx.emplace(start + wire(i + 1), Bytes{reply[i]});
+        } else {
+            rx.emplace(start + wire(reply.size()), reply);
+        }
+    }
+
+    void step_master() {
+        if (!master.busy()) {
+            if (auto t = scheduler.next(now)) {
+                ++starts;
+                if (command_waiting) {
+                    if (t->priority == Priority::command) {
+                        ++commands_started;
+                    } else {
+                        ++commands_not_next;
+                    }
+                }
+                if (t->priority == Priority::command) command_waiting.reset();
+                master.start(std::move(*t), now);
+            }
+        }
+        max_dead_queue = std::max(max_dead_queue, scheduler.online(3) ? 0 : scheduler.queued(3));
+    }
+
+    /// Runs until @p until; returns when idle with nothing due.
+    void run(TimePoint until, bool traffic) {
+        TimePoint next_poll = now;
+        TimePoint next_read = now;
+        TimePoint next_command = now + 13ms;
+        std::uniform_int_distribution<int> live(0, 2);
+        std::uniform_int_distribution<int> any(0, 3);
+        for (int guard = 0; guard < 2'000'000; ++guard) {
+            if (traffic) {
+                while (next_poll <= now) {
+                    for (fe::DeviceIndex d = 0; d < 4; ++d) submit_poll(d);
+                    next_poll += 20ms;
+                }
+                while (next_read <= now) {
+                    const auto d = static_cast<fe::DeviceIndex>(any(rng));
+                    submit(read_tx(d, address_of(d), Priority::on_demand, 0x0000, 4));
+                    next_read += 7ms;
+                }
+                while (next_command <= now) {
+                    submit_command(static_cast<fe::DeviceIndex>(live(rng)));
+                    next_command += 31ms;
+                }
+            }
+            while (!rx.empty() && rx.begin()->first <= now) {
+                master.on_bytes(rx.begin()->second, rx.begin()->first);
+                last_wire = std::max(last_wire, rx.begin()->first);
+                rx.erase(rx.begin());
+            }
+            step_master();
+            auto action = master.next_action(now);
+            if (auto* write = std::get_if<fe::line_action::Write>(&action)) {
+                ++writes;
+                if (now < last_wire + master.timing().t3_5()) ++early_writes;
+                const Bytes request(write->bytes.begin(), write->bytes.end());
+                if (request.front() == dead_address) dead_writes.push_back(now);
+                master.on_written(now);
+                const TimePoint tx_end = now + master.timing().wire_time(request.size());
+                last_wire = std::max(last_wire, tx_end);
+                answer(request, tx_end);
+                continue;
+            }
+            if (auto* finished = std::get_if<fe::line_action::Finished>(&action)) {
+                scheduler.finished(std::move(finished->transaction), finished->outcome, now);
+                continue;
+            }
+            // Idle or Wait: advance virtual time to the next thing that happens.
+            std::optional<TimePoint> next;
+            const auto consider = [&next](TimePoint t) {
+                if (!next || t < *next) next = t;
+            };
+            if (auto* wait = std::get_if<fe::line_action::Wait>(&action)) consider(wait->until);
+            if (!rx.empty()) consider(rx.begin()->first);
+            if (!master.busy()) {
+                if (auto wake = scheduler.next_wakeup(now)) consider(*wake);
+            }
+            if (traffic) {
+                consider(next_poll);
+                consider(next_read);
+                consider(next_command);
+            }
+            if (!next || now >= until) return;
+            REQUIRE(*next >= now);
+            now = std::max(now, *next);
+        }
+        FAIL("the simulation did not settle");
+    }
+};
+
+TEST_CASE("engine loop: two virtual seconds of mixed traffic over a faulty bus") {
+    Simulation sim;
+    sim.run(t0 + 2s, true);
+    // Drain: no new traffic; everything queued is served or probed.
+    sim.run(t0 + 10s, false);
+    sim.scheduler.cancel_all(OutcomeStatus::cancelled, sim.now);
+    CHECK_FALSE(sim.master.busy());
+
+    // Every transaction completed exactly once.
+    std::uint64_t not_once = 0;
+    for (const auto& [number, calls] : sim.done_calls) not_once += calls == 1 ? 0 : 1;
+    CHECK(not_once == 0);
+    CHECK(sim.done_calls.size() == sim.submitted);
+    CHECK(sim.submitted > 500);
+
+    // Never a request before t3.5 of silence after the last byte on the wire.
+    CHECK(sim.early_writes == 0);
+    const auto& c = sim.master.counters();
+    CHECK(sim.writes == c.requests + c.broadcasts);
+
+    // Commands went at the very next start after they were queued.
+    CHECK(sim.commands_started > 20);
+    CHECK(sim.commands_not_next == 0);
+
+    // The faults happened and were handled.
+    CHECK(c.crc_errors > 0);
+    CHECK(c.garbage_bytes > 0);
+    CHECK(c.timeouts > 0);
+    CHECK(c.replies > 300);
+    std::map<OutcomeStatus, int> by_status;
+    for (const auto& [number, status] : sim.final_status) ++by_status[status];
+    CHECK(by_status[OutcomeStatus::ok] > 300);
+    CHECK(by_status[OutcomeStatus::device_offline] > 0);
+
+    // The dead device went offline, held at most one request, and was probed with
+    // back-off (100, 200, 400, 400 ... ms apart, never closer than 100 ms).
+    CHECK_FALSE(sim.scheduler.online(3));
+    CHECK(sim.max_dead_queue <= 1);
+    REQUIRE(sim.dead_writes.size() >= 5);
+    std::size_t closer = 0;
+    for (std::size_t i = 4; i < sim.dead_writes.size(); ++i) {
+        if (sim.dead_writes[i] - sim.dead_writes[i - 1] < 100ms) ++closer;
+    }
+    CHECK(closer == 0);
+    CHECK(sim.dead_writes.size() < 40);  // 2 s of polling at 20 ms would be 100
+    // The live devices stayed online despite lost replies (retries absorb single losses).
+    CHECK(sim.scheduler.online(0));
+    CHECK(sim.scheduler.online(1));
+    CHECK(sim.scheduler.online(2));
+}
+
+}  // namespace
