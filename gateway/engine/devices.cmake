@@ -1,0 +1,19 @@
+# Register image and device profiles (XEG, EXCD203MB, WTEC RTU, WTEC ASCII view,
+# generic Modbus). Pure logic over the protocol codecs: no I/O, no clock.
+add_library(fb_engine_devices STATIC
+  ${CMAKE_CURRENT_LIST_DIR}/register_image.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/device_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/register_map.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/modbus_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/xeg_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/excd_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_common.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_rtu_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_ascii_image.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_ascii_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/generic_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/profile_factory.cpp
+)
+target_include_directories(fb_engine_devices PUBLIC ${PROJECT_SOURCE_DIR}/gateway)
+target_link_libraries(fb_engine_devices PUBLIC fb_protocol PRIVATE fb_build_options)

@@ -1,0 +1,28 @@
+#pragma once
+/// @file generic_profile.hpp
+/// A generic Modbus-RTU device: its register blocks and poll periods come from the
+/// configuration (spec §5). The blocks are the known map: a request outside them
+/// is answered 0x02 locally; writes are allowed only to writable blocks of coils
+/// and holding registers. Adjacent blocks with the same period are read together.
+/// Nothing is decoded (MQTT shows the raw registers); no alarms, never in motion.
+
+#include "engine/profiles/modbus_profile.hpp"
+
+namespace fieldbridge::engine {
+
+class GenericProfile final : public ModbusProfile {
+public:
+    /// Throws ProfileError for no blocks, a count outside 1-125 (1-2000 bits), a
+    /// block past 0xFFFF, or a writable block of a read-only table.
+    explicit GenericProfile(const ProfileOptions& options);
+
+    [[nodiscard]] DeviceType type() const noexcept override { return DeviceType::modbus; }
+    [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
+    [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
+    [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+
+private:
+    [[nodiscard]] std::vector<PollUnit> poll_units() const override;
+};
+
+}  // namespace fieldbridge::engine

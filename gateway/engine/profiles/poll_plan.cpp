@@ -1,0 +1,156 @@
+#include "engine/profiles/poll_plan.hpp"
+
+#include <algorithm>
+#include <tuple>
+#include <utility>
+
+#include "protocol/modbus_pdu.hpp"
+
+namespace fieldbridge::engine {
+
+namespace {
+
+[[nodiscard]] std::uint8_t read_function(Table table) noexcept {
+    switch (table) {
+        case Table::coils: return protocol::fc::read_coils;
+        case Table::discrete_inputs: return protocol::fc::read_discrete_inputs;
+        case Table::holding: return protocol::fc::read_holding_registers;
+        case Table::input: return protocol::fc::read_input_registers;
+    }
+    return protocol::fc::read_holding_registers;
+}
+
+[[nodiscard]] std::size_t block_limit(Table table) noexcept {
+    return is_bit_table(table) ? max_block_bits : max_block_registers;
+}
+
+[[nodiscard]] std::size_t end_of(const RegisterSpan& s) noexcept {
+    return std::size_t{s.address} + s.count;
+}
+
+/// The span covering @p units (ascending, adjacent).
+[[nodiscard]] RegisterSpan covering(const std::vector<RegisterSpan>& units) {
+    const RegisterSpan& first = units.front();
+    const std::size_t end = end_of(units.back());
+    return RegisterSpan{first.table, first.address, static_cast<std::uint16_t>(end - first.address)};
+}
+
+}  // namespace
+
+const char* to_string(PollClass poll_class) noexcept {
+    switch (poll_class) {
+        case PollClass::startup: return "startup";
+        case PollClass::fast: return "fast";
+        case PollClass::slow: return "slow";
+        case PollClass::custom: return "custom";
+    }
+    return "unknown";
+}
+
+Payload read_payload(const RegisterSpan& span) {
+    const std::uint8_t function = read_function(span.table);
+    if (is_bit_table(span.table)) {
+        return ModbusPayload{protocol::ReadBitsRequest{function, span.address, span.count}};
+    }
+    return ModbusPayload{protocol::ReadRegistersRequest{function, span.address, span.count}};
+}
+
+std::vector<PollItem> merge_units(std::vector<PollUnit> units) {
+    const auto key = [](const PollUnit& u) {
+        return std::make_tuple(u.poll_class, u.period, u.motion, u.span.table, u.span.address);
+    };
+    std::sort(units.begin(), units.end(), [&](const PollUnit& a, const PollUnit& b) { return key(a) < key(b); });
+
+    std::vector<PollItem> items;
+    const auto flush = [&items](const PollUnit& like, std::vector<RegisterSpan>& run) {
+        if (run.empty()) {
+            return;
+        }
+        PollItem item;
+        const RegisterSpan span = covering(run);
+        item.payload = read_payload(span);
+        item.poll_class = like.poll_class;
+        item.period = like.period;
+        item.motion = like.motion;
+        item.fills = {span};
+        item.units = std::move(run);
+        run.clear();
+        items.push_back(std::move(item));
+    };
+
+    std::vector<RegisterSpan> run;
+    const PollUnit* run_like = nullptr;
+    for (const PollUnit& u : units) {
+        if (u.span.count == 0) {
+            continue;
+        }
+        const bool same_group = run_like != nullptr && run_like->poll_class == u.poll_class &&
+                                run_like->period == u.period && run_like->motion == u.motion &&
+                                run_like->span.table == u.span.table;
+        const bool touches = same_group && !run.empty() && end_of(run.back()) == u.span.address;
+        const bool fits = touches && end_of(u.span) - run.front().address <= block_limit(u.span.table);
+        // A unit polled twice at the same period (listed twice) is polled once.
+        const bool duplicate = same_group && !run.empty() && run.back() == u.span;
+        if (duplicate) {
+            continue;
+        }
+        if (!fits) {
+            if (run_like != nullptr) {
+                flush(*run_like, run);
+            }
+            run_like = &u;
+        }
+        run.push_back(u.span);
+    }
+    if (run_like != nullptr) {
+        flush(*run_like, run);
+    }
+    return items;
+}
+
+PollPlan::PollPlan(std::vector<PollItem> items) : items_(std::move(items)) {
+    for (PollItem& item : items_) {
+        item.id = next_id_++;
+    }
+}
+
+const PollItem* PollPlan::find(std::uint32_t id) const noexcept {
+    const auto it = std::find_if(items_.begin(), items_.end(), [id](const PollItem& i) { return i.id == id; });
+    return it != items_.end() ? &*it : nullptr;
+}
+
+PollItem PollPlan::make_item(const PollItem& like, std::vector<RegisterSpan> units) {
+    PollItem item;
+    item.id = next_id_++;
+    const RegisterSpan span = covering(units);
+    item.payload = read_payload(span);
+    item.poll_class = like.poll_class;
+    item.period = like.period;
+    item.motion = like.motion;
+    item.fills = {span};
+    item.units = std::move(units);
+    return item;
+}
+
+std::vector<PollItem> PollPlan::on_block_rejected(std::uint32_t id) {
+    const auto it = std::find_if(items_.begin(), items_.end(), [id](const PollItem& i) { return i.id == id; });
+    if (it == items_.end()) {
+        return {};
+    }
+    const PollItem old = std::move(*it);
+    const auto at = items_.erase(it);
+    if (old.units.size() < 2) {
+        // One unit the device will not read even alone: a hole after all.
+        rejected_.insert(rejected_.end(), old.fills.begin(), old.fills.end());
+        return {};
+    }
+    // Halves at a unit boundary: a single bad register is found in log2(n) rejections.
+    const auto middle = old.units.begin() + static_cast<std::ptrdiff_t>(old.units.size() / 2);
+    std::vector<PollItem> split;
+    split.push_back(make_item(old, std::vector<RegisterSpan>(old.units.begin(), middle)));
+    split.push_back(make_item(old, std::vector<RegisterSpan>(middle, old.units.end())));
+    items_.insert(at, split.begin(), split.end());
+    return split;
+}
+
+}  // namespace fieldbridge::engine

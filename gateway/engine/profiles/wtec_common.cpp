@@ -1,0 +1,136 @@
+#include "engine/profiles/wtec_common.hpp"
+
+#include <string>
+#include <utility>
+
+namespace fieldbridge::engine {
+
+namespace {
+
+[[nodiscard]] RegisterDef reg(std::uint16_t address, std::string name, Access access, std::int64_t min,
+                              std::int64_t max) {
+    RegisterDef d;
+    d.table = Table::holding;
+    d.address = address;
+    d.access = access;
+    d.min = min;
+    d.max = max;
+    d.name = std::move(name);
+    return d;
+}
+
+}  // namespace
+
+std::vector<RegisterDef> wtec_uniform_defs(bool ascii_view) {
+    using namespace wtec_reg;
+    std::vector<RegisterDef> defs;
+    // Table 2.3: "写入0x0001表示回零位"; not readable (table 2.2 has no read).
+    RegisterDef init = reg(initialize, "initialize", Access::write, 1, 1);
+    init.motion = true;
+    defs.push_back(std::move(init));
+    // Table 2.12: 1 e-stops, "只能通过初始化解锁" (only initialising releases it).
+    RegisterDef stop = reg(estop, "estop", Access::read_write, 1, 1);
+    stop.motion = true;
+    stop.stop_value = 1;
+    defs.push_back(std::move(stop));
+    defs.push_back(reg(force, "force", Access::read_write, 20, 100));  // table 2.5
+    defs.push_back(reg(speed, "speed", Access::read_write, 1, 100));   // table 2.7
+    RegisterDef pos = reg(position, "position", Access::read_write, 0, 100);  // table 2.6: "运行电爪并配置位置"
+    pos.motion = true;
+    defs.push_back(std::move(pos));
+    defs.push_back(reg(init_state, "init state", Access::read, 0, 0xFFFF));
+    defs.push_back(reg(grip_state, "grip state", Access::read, 0, 0xFFFF));
+    defs.push_back(reg(instant_position, "instant position", Access::read, 0, 100));
+    defs.push_back(reg(init_direction, "init direction", Access::read_write, 1, 2));  // table 2.9
+    RegisterDef flash = ascii_view ? reg(save, "save", Access::write, 1, 1)
+                                   : reg(save, "save", Access::read_write, 0, 1);  // table 2.10
+    flash.protect = true;
+    defs.push_back(std::move(flash));
+    // Table 2.11 allows 0-255; 0 is the broadcast address and the ASCII protocol
+    // stops at 253 (0xFD): 1-253 in both modes.
+    RegisterDef id = reg(device_id, "device id", Access::read_write, 1, 253);
+    id.protect = true;
+    defs.push_back(std::move(id));
+    return defs;
+}
+
+std::string_view wtec_init_state_name(std::uint16_t value) noexcept {
+    switch (value) {
+        case wtec_reg::init_not_done: return "not_initialized";
+        case wtec_reg::init_done: return "initialized";
+        case wtec_reg::init_failed: return "failed";
+        case wtec_reg::init_running: return "initializing";
+        default: return "unknown";
+    }
+}
+
+std::string_view wtec_grip_state_name(std::uint16_t value) noexcept {
+    switch (value) {
+        case wtec_reg::grip_moving: return "moving";
+        case wtec_reg::grip_reached: return "reached";
+        case wtec_reg::grip_gripped: return "gripped";
+        case wtec_reg::grip_released:
+        case wtec_reg::grip_released_hex: return "motor_released";
+        default: return "unknown";
+    }
+}
+
+bool wtec_in_motion(const RegisterImage& image) {
+    return image.value(Table::holding, wtec_reg::grip_state) == wtec_reg::grip_moving ||
+           image.value(Table::holding, wtec_reg::init_state) == wtec_reg::init_running;
+}
+
+void decode_wtec_uniform(const RegisterImage& image, DecodedState& state) {
+    using namespace wtec_reg;
+    const auto value = [&image](std::uint16_t address) { return image.value(Table::holding, address); };
+    if (const auto v = value(init_state)) {
+        state.fields.push_back({"init_state", std::string{wtec_init_state_name(*v)}, ""});
+        state.fields.push_back({"init_state_code", std::int64_t{*v}, ""});
+    }
+    if (const auto v = value(grip_state)) {
+        state.fields.push_back({"grip_state", std::string{wtec_grip_state_name(*v)}, ""});
+        state.fields.push_back({"grip_state_code", std::int64_t{*v}, ""});
+    }
+    if (const auto v = value(instant_position)) {
+        state.fields.push_back({"position_pct", std::int64_t{*v}, "%"});
+    }
+    if (const auto v = value(position)) {
+        state.fields.push_back({"target_pct", std::int64_t{*v}, "%"});
+    }
+    if (const auto v = value(force)) {
+        state.fields.push_back({"force_pct", std::int64_t{*v}, "%"});
+    }
+    if (const auto v = value(speed)) {
+        state.fields.push_back({"speed_pct", std::int64_t{*v}, "%"});
+    }
+    if (const auto v = value(estop)) {
+        state.fields.push_back({"estop", *v != 0, ""});
+    }
+    if (const auto v = value(init_direction)) {
+        const std::string name = *v == direction_open ? "open" : *v == direction_close ? "close" : "unknown";
+        state.fields.push_back({"init_direction", name, ""});
+    }
+}
+
+std::vector<Alarm> wtec_uniform_alarms(const RegisterImage& image, std::optional<std::uint16_t> raw_homing_code) {
+    using namespace wtec_reg;
+    std::vector<Alarm> out;
+    if (image.value(Table::holding, init_state) == init_failed) {
+        // Seed 003 command 11: 03 is "超过极限位置" (beyond the limit position),
+        // shown as failed (2) in the uniform register.
+        if (raw_homing_code == 0x03) {
+            out.push_back(Alarm{"beyond_limit", "homing went beyond the limit position; check the stroke and initialise again",
+                                Severity::error, "holding 0x0200"});
+        } else {
+            out.push_back(Alarm{"init_failed", "initialisation (homing) failed; remove any obstacle and initialise again",
+                                Severity::error, "holding 0x0200"});
+        }
+    }
+    if (image.value(Table::holding, estop) == 1) {
+        out.push_back(Alarm{"emergency_stop", "emergency stop latched; only initialising (0x0100 = 1) releases it",
+                            Severity::critical, "holding 0x0102"});
+    }
+    return out;
+}
+
+}  // namespace fieldbridge::engine

@@ -1,0 +1,60 @@
+#include "engine/profiles/wtec_rtu_profile.hpp"
+
+#include <utility>
+
+#include "engine/profiles/wtec_common.hpp"
+
+namespace fieldbridge::engine {
+
+namespace {
+
+[[nodiscard]] WireFunctions wire_functions() {
+    // Seed 003 §2.1.1: "常见功能码有 03、06"; FC16 is translated to FC06s.
+    return WireFunctions{{protocol::fc::read_holding_registers, protocol::fc::write_single_register,
+                          protocol::fc::write_multiple_registers},
+                         false, true};
+}
+
+}  // namespace
+
+WtecRtuProfile::WtecRtuProfile(const ProfileOptions& options)
+    : ModbusProfile(std::make_shared<const RegisterMap>(wtec_uniform_defs(false)), wire_functions(), options,
+                    WordOrder::high_first) {}
+
+std::vector<PollUnit> WtecRtuProfile::poll_units() const {
+    using namespace wtec_reg;
+    std::vector<PollUnit> units;
+    const auto add = [&units](std::vector<PollUnit> more) { units.insert(units.end(), more.begin(), more.end()); };
+    // Status fast; the holes between them are never bridged (rule 8): three reads.
+    add(units_for(Table::holding, init_state, 1, PollClass::fast, true));
+    add(units_for(Table::holding, grip_state, 1, PollClass::fast, true));
+    add(units_for(Table::holding, instant_position, 1, PollClass::fast, true));
+    // Settings slow: 0x0102-0x0105 in one read, 0x0300, 0x0302-0x0303.
+    add(units_for(Table::holding, estop, 4, PollClass::slow));
+    add(units_for(Table::holding, init_direction, 1, PollClass::slow));
+    add(units_for(Table::holding, save, 2, PollClass::slow));
+    return units;
+}
+
+bool WtecRtuProfile::in_motion(const RegisterImage& image) const {
+    return wtec_in_motion(image);
+}
+
+DecodedState WtecRtuProfile::decode_state(const RegisterImage& image) const {
+    DecodedState state;
+    decode_wtec_uniform(image, state);
+    if (const auto v = image.value(Table::holding, wtec_reg::save)) {
+        // Table 2.10: 1 = new data was saved and loaded at power-up.
+        state.fields.push_back({"saved", *v == 1, ""});
+    }
+    if (const auto v = image.value(Table::holding, wtec_reg::device_id)) {
+        state.fields.push_back({"device_id", std::int64_t{*v}, ""});
+    }
+    return state;
+}
+
+std::vector<Alarm> WtecRtuProfile::alarms(const RegisterImage& image) const {
+    return wtec_uniform_alarms(image, std::nullopt);
+}
+
+}  // namespace fieldbridge::engine

@@ -1,0 +1,271 @@
+#include "engine/profiles/xeg_profile.hpp"
+
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/profiles/profile_text.hpp"
+
+namespace fieldbridge::engine {
+
+namespace {
+
+using protocol::ExceptionCode;
+
+// Seed 001 §3 "Data Allocation Table".
+constexpr std::uint16_t di_first = 0x0000;   // IN1-IN6, START, (unused)
+constexpr std::uint16_t do_first = 0x0010;   // POS HOLD BUSY ALM1 ALM2 CHK1 CHK2 CHK3
+constexpr std::uint16_t do_alm1 = 0x0013;
+constexpr std::uint16_t do_alm2 = 0x0014;
+constexpr std::uint16_t position = 0x0300;   // 0.01 mm
+constexpr std::uint16_t status = 0x0301;     // 0-7, §3.2
+constexpr std::uint16_t firmware = 0x0303;   // 0x0303-0x0306, §3.2
+constexpr std::uint16_t model = 0x0600;
+constexpr std::uint16_t move_position = 0x0630;
+constexpr std::uint16_t move_speed = 0x0631;
+constexpr std::uint16_t expert_move = 0x0641;
+constexpr std::uint16_t expert_speed = 0x0642;
+constexpr std::uint16_t hold_stroke = 0x0643;
+constexpr std::uint16_t hold_speed = 0x0644;
+constexpr std::uint16_t hold_force = 0x0645;
+
+constexpr std::uint16_t status_working = 1;
+
+// Seed 001 §3.4.2: "All electric grippers moving range" (mm, mm/s, %), in register
+// units (0.01). The manual's "FXEG-16" row is XEG-16 (0x0A10, §3.3).
+constexpr std::array<XegModelLimits, 5> model_table{{
+    {0x0A10, "XEG-16", 1600, 6000, 1000, 50},
+    {0x0A20, "XEG-32", 3200, 8000, 2000, 40},
+    {0x0A21, "XEG-32-PR", 3200, 6000, 1000, 50},
+    {0x0A30, "XEG-48", 4800, 8000, 2000, 50},
+    {0x0A40, "XEG-64", 6400, 10000, 2000, 40},
+}};
+
+constexpr std::array<std::string_view, 8> di_names{"in1", "in2", "in3", "in4", "in5", "in6", "start", "di7"};
+constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1", "alm2", "chk1", "chk2", "chk3"};
+
+[[nodiscard]] RegisterDef reg(Table table, std::uint16_t address, std::string name, Access access,
+                              std::int64_t min = 0, std::int64_t max = 0xFFFF, std::uint16_t count = 1) {
+    RegisterDef d;
+    d.table = table;
+    d.address = address;
+    d.count = count;
+    d.access = access;
+    d.min = min;
+    d.max = max;
+    d.name = std::move(name);
+    return d;
+}
+
+[[nodiscard]] RegisterDef motion(RegisterDef d, bool auto_reset = false) {
+    d.motion = true;
+    d.auto_reset = auto_reset;
+    return d;
+}
+
+[[nodiscard]] std::shared_ptr<const RegisterMap> build_map() {
+    using enum Table;
+    std::vector<RegisterDef> defs{
+        reg(discrete_inputs, di_first, "DI", Access::read, 0, 1, 8),
+        reg(discrete_inputs, do_first, "DO", Access::read, 0, 1, 8),
+        reg(input, position, "position", Access::read),
+        reg(input, status, "status", Access::read),
+        reg(input, firmware, "firmware", Access::read, 0, 0xFFFF, 4),
+    };
+    // §3 gives 0-2660 for the model; check_value() narrows it to the §3.3 list.
+    RegisterDef type = reg(holding, model, "EG type", Access::read_write, 0, 2660);
+    // Writing the model reconfigures the controller for another gripper (the quick
+    // start of Appendix 1 does it once): a set-up action, protected like an ID.
+    type.protect = true;
+    defs.push_back(std::move(type));
+    // §3 gives the trigger as 1-63 (§3.4.1 says 0-63: 0 would trigger nothing).
+    defs.push_back(motion(reg(holding, 0x0601, "trigger", Access::read_write, 1, 63), true));
+    defs.push_back(motion(reg(holding, 0x0610, "reset", Access::read_write, 0, 1), true));
+    RegisterDef stop = motion(reg(holding, 0x0620, "stop", Access::read_write, 0, 1), true);
+    stop.stop_value = 1;
+    defs.push_back(std::move(stop));
+    defs.push_back(motion(reg(holding, move_position, "move", Access::read_write, 0, 6400)));
+    defs.push_back(motion(reg(holding, move_speed, "move speed", Access::read_write, 0, 10000)));
+    defs.push_back(motion(reg(holding, 0x0632, "move flag", Access::read_write, 0, 1), true));
+    defs.push_back(motion(reg(holding, 0x0640, "expert direction", Access::read_write, 0, 1)));
+    defs.push_back(motion(reg(holding, expert_move, "expert move", Access::read_write, 0, 6400)));
+    defs.push_back(motion(reg(holding, expert_speed, "expert speed", Access::read_write, 0, 10000)));
+    defs.push_back(motion(reg(holding, hold_stroke, "holding stroke", Access::read_write, 0, 6400)));
+    defs.push_back(motion(reg(holding, hold_speed, "holding speed", Access::read_write, 0, 2000)));
+    defs.push_back(motion(reg(holding, hold_force, "holding force", Access::read_write, 40, 100)));
+    defs.push_back(motion(reg(holding, 0x0646, "expert flag", Access::read_write, 0, 1), true));
+    return std::make_shared<const RegisterMap>(std::move(defs));
+}
+
+[[nodiscard]] WireFunctions wire_functions() {
+    // Seed 001 §4.1 function code table; FC06 is accepted northbound and translated.
+    return WireFunctions{{protocol::fc::read_discrete_inputs, protocol::fc::read_holding_registers,
+                          protocol::fc::read_input_registers, protocol::fc::write_single_register,
+                          protocol::fc::read_exception_status, protocol::fc::write_multiple_registers},
+                         true, false};
+}
+
+[[nodiscard]] XegModelLimits limits_in(const RegisterImage& image) {
+    if (const auto m = image.value(Table::holding, model)) {
+        if (const auto known = xeg_model_limits(*m)) {
+            return *known;
+        }
+    }
+    return xeg_widest_limits();
+}
+
+}  // namespace
+
+std::optional<XegModelLimits> xeg_model_limits(std::uint16_t value) noexcept {
+    for (const XegModelLimits& l : model_table) {
+        if (l.model == value) {
+            return l;
+        }
+    }
+    return std::nullopt;
+}
+
+XegModelLimits xeg_widest_limits() noexcept {
+    return XegModelLimits{0, "unknown", 6400, 10000, 2000, 40};
+}
+
+std::string_view xeg_exception_status_text(std::uint8_t code) noexcept {
+    // Seed 001 §4.2.4 "Exception Status Code".
+    switch (code) {
+        case 0x00: return "no error";
+        case 0x02: return "emergency stop";
+        case 0x03: return "no command for this address";
+        case 0x04: return "incorrect gripper type";
+        case 0x05: return "incorrect reset";
+        case 0x06: return "incorrect stop";
+        case 0x07: return "incorrect move";
+        case 0x08: return "incorrect expert";
+        case 0x10: return "move error";
+        case 0x11: return "move error (over range)";
+        case 0x12: return "reset error";
+        default: return "exception status not in the manual";
+    }
+}
+
+std::string_view xeg_status_name(std::uint16_t value) noexcept {
+    constexpr std::array<std::string_view, 8> names{"idle",           "working",    "positioned", "holding",
+                                                    "position_alarm", "move_alarm", "home_alarm", "emergency_stop"};
+    return value < names.size() ? names[value] : "unknown";
+}
+
+XegProfile::XegProfile(const ProfileOptions& options)
+    : ModbusProfile(build_map(), wire_functions(), options, WordOrder::high_first) {}
+
+std::optional<ExceptionCode> XegProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
+                                                     std::int64_t value, const RegisterImage& image) const {
+    const XegModelLimits l = limits_in(image);
+    bool ok = true;
+    switch (unit_address) {
+        case model: ok = xeg_model_limits(static_cast<std::uint16_t>(value)).has_value(); break;
+        case move_position:
+        case expert_move:
+        case hold_stroke: ok = value <= l.stroke; break;
+        case move_speed:
+        case expert_speed: ok = value <= l.speed; break;
+        case hold_speed: ok = value <= l.hold_speed; break;
+        case hold_force: ok = value >= l.force_min; break;
+        default: break;
+    }
+    return ok ? std::nullopt : std::optional<ExceptionCode>{ExceptionCode::illegal_data_value};
+}
+
+std::vector<PollUnit> XegProfile::poll_units() const {
+    std::vector<PollUnit> units;
+    const auto add = [&units](std::vector<PollUnit> more) { units.insert(units.end(), more.begin(), more.end()); };
+    // Spec §5: model and firmware at start, status fast, I/O slower.
+    add(units_for(Table::holding, model, 1, PollClass::startup));
+    add(units_for(Table::input, firmware, 4, PollClass::startup));
+    add(units_for(Table::input, position, 2, PollClass::fast, true));
+    // 0x0008-0x000F is a hole: two FC02 reads, never one across it.
+    add(units_for(Table::discrete_inputs, di_first, 8, PollClass::slow));
+    add(units_for(Table::discrete_inputs, do_first, 8, PollClass::slow));
+    return units;
+}
+
+void XegProfile::on_device_exception(const protocol::Request& /*sent*/, ExceptionCode code,
+                                     ApplyResult& result) const {
+    // Seed 001 §4.2.4 / §5: after exception 04 read the exception status (FC07).
+    if (code == ExceptionCode::server_device_failure) {
+        result.follow_up = ModbusPayload{protocol::ReadExceptionStatusRequest{}};
+    }
+}
+
+void XegProfile::apply_other(const protocol::Request& sent, const protocol::Response& reply,
+                             RegisterImage& /*image*/, TimePoint /*now*/, ApplyResult& result) const {
+    const auto* status_reply = std::get_if<protocol::ReadExceptionStatusResponse>(&reply);
+    if (!std::holds_alternative<protocol::ReadExceptionStatusRequest>(sent) || status_reply == nullptr) {
+        result.status = ApplyStatus::not_applicable;
+        return;
+    }
+    result.notice = DeviceNotice{status_reply->status,
+                                 "exception status " + hex_byte(status_reply->status) + ": " +
+                                     std::string{xeg_exception_status_text(status_reply->status)}};
+}
+
+bool XegProfile::in_motion(const RegisterImage& image) const {
+    return image.value(Table::input, status) == status_working;
+}
+
+DecodedState XegProfile::decode_state(const RegisterImage& image) const {
+    DecodedState state;
+    if (const auto s = image.value(Table::input, status)) {
+        state.fields.push_back({"status", std::string{xeg_status_name(*s)}, ""});
+        state.fields.push_back({"status_code", std::int64_t{*s}, ""});
+    }
+    if (const auto p = image.value(Table::input, position)) {
+        state.fields.push_back({"position_mm", static_cast<double>(*p) / 100.0, "mm"});
+    }
+    if (const auto m = image.value(Table::holding, model)) {
+        const auto l = xeg_model_limits(*m);
+        state.fields.push_back({"model", l ? std::string{l->name} : "unknown (" + hex_word(*m) + ")", ""});
+    }
+    std::array<std::optional<std::uint16_t>, 4> fw{};
+    for (std::size_t i = 0; i < fw.size(); ++i) {
+        fw[i] = image.value(Table::input, static_cast<std::uint16_t>(firmware + i));
+    }
+    if (fw[0] && fw[1] && fw[2] && fw[3]) {
+        // Seed 001 §3.2 / Appendix 1: 3, 0, 1, 884 reads "V3.0.1.884".
+        state.fields.push_back({"firmware",
+                                "V" + std::to_string(*fw[0]) + "." + std::to_string(*fw[1]) + "." +
+                                    std::to_string(*fw[2]) + "." + std::to_string(*fw[3]),
+                                ""});
+    }
+    for (std::size_t i = 0; i < 8; ++i) {
+        if (const auto v = image.value(Table::discrete_inputs, static_cast<std::uint16_t>(di_first + i))) {
+            state.fields.push_back({"di_" + std::string{di_names[i]}, *v != 0, ""});
+        }
+        if (const auto v = image.value(Table::discrete_inputs, static_cast<std::uint16_t>(do_first + i))) {
+            state.fields.push_back({"do_" + std::string{do_names[i]}, *v != 0, ""});
+        }
+    }
+    return state;
+}
+
+std::vector<Alarm> XegProfile::alarms(const RegisterImage& image) const {
+    std::vector<Alarm> out;
+    if (const auto s = image.value(Table::input, status); s && *s >= 4 && *s <= 7) {
+        // Seed 001 §3.2: status 4-7 are alarms; 7 is the emergency-stop circuit.
+        constexpr std::array<std::string_view, 4> texts{
+            "position failure: the gripper did not reach the position",
+            "move alarm: the motion was obstructed or failed",
+            "home reset failure: initialise (reset 0x0610) again after clearing the obstacle",
+            "emergency stop: the emergency circuit is open; close it and reset"};
+        out.push_back(Alarm{std::string{xeg_status_name(*s)}, std::string{texts[*s - 4]},
+                            *s == 7 ? Severity::critical : Severity::error, "input 0x0301"});
+    }
+    if (image.value(Table::discrete_inputs, do_alm1) == 1) {
+        out.push_back(Alarm{"alm1", "alarm output ALM1 is on", Severity::error, "discrete input 0x0013"});
+    }
+    if (image.value(Table::discrete_inputs, do_alm2) == 1) {
+        out.push_back(Alarm{"alm2", "alarm output ALM2 is on", Severity::error, "discrete input 0x0014"});
+    }
+    return out;
+}
+
+}  // namespace fieldbridge::engine
