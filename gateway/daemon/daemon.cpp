@@ -1,0 +1,332 @@
+#include "daemon/daemon.hpp"
+
+#include <algorithm>
+#include <csignal>
+#include <exception>
+#include <stdexcept>
+#include <system_error>
+#include <utility>
+
+#include <asio/post.hpp>
+
+#include "config/diagnostic.hpp"
+#include "daemon/config_summary.hpp"
+#include "daemon/exit_codes.hpp"
+#include "daemon/logging.hpp"
+#include "daemon/watchdog.hpp"
+
+namespace fieldbridge::daemon {
+
+namespace {
+
+[[nodiscard]] std::string join(const std::vector<std::string>& names) {
+    std::string text;
+    for (const auto& name : names) {
+        text += (text.empty() ? "" : ", ") + name;
+    }
+    return text;
+}
+
+[[nodiscard]] const char* signal_name(int signal_number) noexcept {
+    switch (signal_number) {
+        case SIGTERM:
+            return "SIGTERM";
+        case SIGINT:
+            return "SIGINT";
+        case SIGHUP:
+            return "SIGHUP";
+        default:
+            return "a signal";
+    }
+}
+
+/// "RELOADING=1" with the time of the request: systemd 253+ (Type=notify-reload)
+/// needs MONOTONIC_USEC= with it to tell this reload from an older one, and older
+/// managers ignore it. steady_clock is CLOCK_MONOTONIC on Linux, the clock
+/// sd_notify(3) asks for.
+[[nodiscard]] std::string reloading_message() {
+    const auto now = std::chrono::duration_cast<std::chrono::microseconds>(
+        std::chrono::steady_clock::now().time_since_epoch());
+    return "RELOADING=1\nMONOTONIC_USEC=" + std::to_string(now.count());
+}
+
+}  // namespace
+
+Daemon::Daemon(DaemonOptions options, std::shared_ptr<const config::Config> initial, ConfigLoader load,
+               ServiceManager& manager, std::shared_ptr<spdlog::logger> logger)
+    : options_(std::move(options)),
+      config_(std::move(initial)),
+      load_(std::move(load)),
+      manager_(manager),
+      logger_(std::move(logger)),
+      signals_(io_, SIGTERM, SIGINT, SIGHUP),
+      stop_timer_(io_),
+      status_refresh_(io_, options_.status_period, [this] { publish_status(false); }),
+      readiness_([this] { asio::post(io_, [this] { on_ready(); }); }) {
+    if (!config_) {
+        throw std::invalid_argument("Daemon: no initial configuration");
+    }
+    status_.add([this] { return phase_note(); });
+    status_.add([this] { return describe_inventory(*config_); });
+}
+
+Daemon::~Daemon() = default;
+
+void Daemon::add_component(Component& component) {
+    if (ran_) {
+        throw std::logic_error("Daemon: component '" + component.name() + "' added after run()");
+    }
+    components_.push_back(&component);
+}
+
+void Daemon::add_status(StatusContributor contributor) { status_.add(std::move(contributor)); }
+
+int Daemon::run() {
+    if (ran_) {
+        throw std::logic_error("Daemon::run() called twice");
+    }
+    ran_ = true;
+    apply_log_level();
+    logger_->info("starting gateway '{}' with {} ({})", config_->gateway.id, options_.config_file.string(),
+                  describe_config(*config_));
+
+    wait_for_signal();
+    if (const auto interval = watchdog_ping_interval(manager_.watchdog_timeout())) {
+        logger_->info("systemd watchdog enabled: pinging every {} ms",
+                      std::chrono::duration<double, std::milli>(*interval).count());
+        watchdog_.emplace(io_, *interval, [this] { notify("WATCHDOG=1"); });
+        watchdog_->start(true);
+    }
+    status_refresh_.start(false);
+    asio::post(io_, [this] { start_components(); });
+
+    try {
+        io_.run();
+    } catch (const std::exception& error) {
+        // A try/catch wall around every handler: an exception escaping a duty
+        // leaves its component in an unknown state, so the process ends and
+        // systemd's Restart=on-failure brings it back.
+        logger_->critical("internal error, exiting: {}", error.what());
+        manager_.notify("STOPPING=1");
+        return exit_failure;
+    }
+    return exit_code_;
+}
+
+void Daemon::wait_for_signal() {
+    signals_.async_wait([this](const std::error_code& error, int signal_number) {
+        if (error || phase_ == Phase::stopped) {
+            return;
+        }
+        on_signal(signal_number);
+        if (phase_ != Phase::stopped) {
+            wait_for_signal();
+        }
+    });
+}
+
+void Daemon::on_signal(int signal_number) {
+    if (signal_number == SIGHUP) {
+        logger_->info("SIGHUP received: reloading the configuration");
+        request_reload();
+    } else {
+        request_stop(std::string(signal_name(signal_number)) + " received");
+    }
+}
+
+void Daemon::start_components() {
+    if (phase_ != Phase::starting) {
+        return;
+    }
+    for (auto* component : components_) {
+        try {
+            StartContext context(config_, readiness_);
+            logger_->debug("starting {}", component->name());
+            component->start(context);
+            ++started_;
+        } catch (const std::exception& error) {
+            fail("cannot start " + component->name() + ": " + error.what());
+            return;
+        }
+    }
+    // "starting, waiting for ..." names what READY=1 still waits for.
+    publish_status(true);
+    readiness_.arm();
+}
+
+void Daemon::on_ready() {
+    if (phase_ != Phase::starting) {
+        return;
+    }
+    phase_ = Phase::running;
+    const auto status = status_.take_if_changed(true);
+    notify("READY=1\nSTATUS=" + status.value_or(""));
+    logger_->info("ready: {}", status.value_or(""));
+    if (reload_pending_) {
+        reload_pending_ = false;
+        reload();
+    }
+}
+
+void Daemon::request_reload() {
+    switch (phase_) {
+        case Phase::starting:
+            logger_->info("reload requested during start-up: it runs once the gateway is ready");
+            reload_pending_ = true;
+            return;
+        case Phase::stopping:
+        case Phase::stopped:
+            logger_->info("reload ignored: the gateway is stopping");
+            return;
+        case Phase::running:
+            reload();
+            return;
+    }
+}
+
+void Daemon::reload() {
+    notify(reloading_message());
+    const auto& file = options_.config_file;
+    std::shared_ptr<const config::Config> next;
+    logger_->debug("re-reading {}", file.string());
+    try {
+        next = load_(file);
+    } catch (const config::ConfigError& error) {
+        for (const auto& diagnostic : error.diagnostics()) {
+            logger_->error("{}", diagnostic.to_string());
+        }
+        logger_->error("configuration reload rejected: {} in {}; the gateway keeps running with the previous "
+                       "configuration; fix the file and reload again",
+                       count_of(error.diagnostics().size(), "problem", "problems"), file.string());
+        last_reload_rejected_ = true;
+    } catch (const std::exception& error) {
+        logger_->error("configuration reload failed: {}: {}; the gateway keeps running with the previous "
+                       "configuration",
+                       file.string(), error.what());
+        last_reload_rejected_ = true;
+    }
+    if (next) {
+        config_ = std::move(next);
+        last_reload_rejected_ = false;
+        apply_log_level();
+        for (auto* component : components_) {
+            try {
+                component->apply(config_);
+            } catch (const std::exception& error) {
+                logger_->error("{} could not apply the new configuration: {}; it may still run with parts of the "
+                               "previous one; restart the service to be sure",
+                               component->name(), error.what());
+            }
+        }
+        logger_->info("configuration reloaded from {} ({})", file.string(), describe_config(*config_));
+    }
+    notify("READY=1\nSTATUS=" + status_.take_if_changed(true).value_or(""));
+}
+
+void Daemon::request_stop(const std::string& reason) {
+    if (phase_ == Phase::stopped) {
+        return;
+    }
+    if (phase_ == Phase::stopping) {
+        const auto pending = stopped_ ? stopped_->pending() : std::vector<std::string>{};
+        logger_->warn("{} while stopping: exiting now{}", reason,
+                      pending.empty() ? std::string() : ", without waiting for " + join(pending));
+        finish();
+        return;
+    }
+    phase_ = Phase::stopping;
+    logger_->info("stopping: {}", reason);
+    notify("STOPPING=1\nSTATUS=" + status_.take_if_changed(true).value_or(""));
+
+    stopped_ = std::make_unique<CompletionBarrier>([this] {
+        asio::post(io_, [this] {
+            logger_->info("stopped");
+            finish();
+        });
+    });
+    for (auto i = started_; i > 0; --i) {
+        auto* component = components_[i - 1];
+        try {
+            StopContext context(*stopped_);
+            logger_->debug("stopping {}", component->name());
+            component->stop(context);
+        } catch (const std::exception& error) {
+            logger_->error("error while stopping {}: {}", component->name(), error.what());
+        }
+    }
+    stopped_->arm();
+    if (!stopped_->complete()) {
+        stop_timer_.expires_after(options_.stop_timeout);
+        stop_timer_.async_wait([this](const std::error_code& error) {
+            if (error || phase_ != Phase::stopping) {
+                return;
+            }
+            logger_->warn("stop timeout ({} ms) expired: exiting without waiting for {}",
+                          options_.stop_timeout.count(), join(stopped_->pending()));
+            finish();
+        });
+    }
+}
+
+void Daemon::fail(const std::string& reason) {
+    logger_->error("{}", reason);
+    exit_code_ = exit_failure;
+    request_stop("fatal error");
+}
+
+void Daemon::finish() {
+    phase_ = Phase::stopped;
+    if (watchdog_) {
+        watchdog_->cancel();
+    }
+    status_refresh_.cancel();
+    stop_timer_.cancel();
+    std::error_code ignored;
+    signals_.cancel(ignored);
+    // Components' own pending operations are abandoned: they were told to stop
+    // and had their time.
+    io_.stop();
+}
+
+void Daemon::notify(const std::string& state) {
+    if (logger_->should_log(spdlog::level::debug) && state != "WATCHDOG=1") {
+        std::string one_line = state;
+        std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+        logger_->debug("to the service manager: {}", one_line);
+    }
+    manager_.notify(state);
+}
+
+void Daemon::apply_log_level() {
+    const auto level = to_spdlog_level(options_.log_level_override.value_or(config_->gateway.log_level));
+    if (logger_->level() != level) {
+        logger_->set_level(level);
+        logger_->info("log level: {}", spdlog::level::to_string_view(level));
+    }
+}
+
+void Daemon::publish_status(bool force) {
+    if (phase_ == Phase::stopped) {
+        return;
+    }
+    if (const auto status = status_.take_if_changed(force)) {
+        notify("STATUS=" + *status);
+    }
+}
+
+std::string Daemon::phase_note() const {
+    switch (phase_) {
+        case Phase::starting: {
+            const auto pending = readiness_.pending();
+            return pending.empty() ? "starting" : "starting, waiting for " + join(pending);
+        }
+        case Phase::stopping:
+        case Phase::stopped:
+            return "stopping";
+        case Phase::running:
+            break;
+    }
+    return last_reload_rejected_ ? "last reload rejected (see the log)" : "";
+}
+
+}  // namespace fieldbridge::daemon

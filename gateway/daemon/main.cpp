@@ -1,0 +1,89 @@
+// fieldbridge: the gateway's entry point. Parses the command line, creates the
+// logger, loads the configuration, and hands everything to the Daemon.
+
+#include <spdlog/sinks/stdout_sinks.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <type_traits>
+#include <variant>
+
+#include "config/config_loader.hpp"
+#include "daemon/check_config.hpp"
+#include "daemon/command_line.hpp"
+#include "daemon/daemon.hpp"
+#include "daemon/exit_codes.hpp"
+#include "daemon/logging.hpp"
+#include "daemon/systemd_service_manager.hpp"
+
+#ifndef FIELDBRIDGE_VERSION
+#error "FIELDBRIDGE_VERSION must be defined by the build (gateway/daemon/CMakeLists.txt)"
+#endif
+
+namespace {
+
+using namespace fieldbridge;
+
+[[nodiscard]] std::shared_ptr<const config::Config> load(const std::filesystem::path& file) {
+    return config::load_config_file(file);
+}
+
+[[nodiscard]] int run_gateway(const daemon::RunCommand& command) {
+    // systemd.exec(5): JOURNAL_STREAM names the journal stream stderr is connected to.
+    const auto format = daemon::detect_log_format(std::getenv("JOURNAL_STREAM"), STDERR_FILENO);
+    auto logger = daemon::make_logger("fieldbridge", std::make_shared<spdlog::sinks::stderr_sink_mt>(), format);
+    logger->set_level(daemon::to_spdlog_level(command.log_level.value_or(config::LogLevel::info)));
+    logger->info("fieldbridge {}", FIELDBRIDGE_VERSION);
+
+    std::shared_ptr<const config::Config> initial;
+    try {
+        initial = load(command.config_file);
+    } catch (const config::ConfigError& error) {
+        for (const auto& diagnostic : error.diagnostics()) {
+            logger->error("{}", diagnostic.to_string());
+        }
+        logger->error("cannot start: the configuration {} cannot be used ({}); fix it (fieldbridge --check-config {} "
+                      "lists every problem) and start again",
+                      command.config_file.string(),
+                      daemon::count_of(error.diagnostics().size(), "problem", "problems"),
+                      command.config_file.string());
+        return daemon::exit_config_error;
+    }
+
+    daemon::SystemdServiceManager manager(logger);
+    daemon::DaemonOptions options;
+    options.config_file = command.config_file;
+    options.log_level_override = command.log_level;
+    daemon::Daemon gateway(std::move(options), std::move(initial), load, manager, logger);
+    // Components (line engine, Modbus TCP server, MQTT bridge) register here with
+    // gateway.add_component() and gateway.add_status() as they are added.
+    return gateway.run();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        const daemon::CommandLine command_line(FIELDBRIDGE_VERSION);
+        const auto command = command_line.parse(argc, argv, std::cout, std::cerr);
+        return std::visit(
+            [](const auto& chosen) -> int {
+                using Chosen = std::decay_t<decltype(chosen)>;
+                if constexpr (std::is_same_v<Chosen, daemon::RunCommand>) {
+                    return run_gateway(chosen);
+                } else if constexpr (std::is_same_v<Chosen, daemon::CheckConfigCommand>) {
+                    return daemon::check_config(chosen.config_file, load, std::cout, std::cerr);
+                } else if constexpr (std::is_same_v<Chosen, daemon::SubcommandCommand>) {
+                    return chosen.subcommand->run(chosen.log_level);
+                } else {
+                    return chosen.exit_code;
+                }
+            },
+            command);
+    } catch (const std::exception& error) {
+        std::cerr << "fieldbridge: internal error: " << error.what() << '\n';
+        return daemon::exit_failure;
+    }
+}
