@@ -12,7 +12,8 @@ packages=(
   libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
   libcli11-dev
   # test and demo tools
-  socat mosquitto mosquitto-clients mbpoll python3 python3-pymodbus procps
+  socat mosquitto mosquitto-clients mbpoll python3 python3-pymodbus
+  python3-serial-asyncio procps  # pymodbus.client imports serial_asyncio (a Recommends)
 )
 
 missing=()

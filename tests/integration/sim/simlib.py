@@ -69,6 +69,67 @@ def h(text: str) -> bytes:
     return bytes.fromhex(text)
 
 
+def readdress_rtu(adu: bytes, address: int) -> bytes:
+    """The same RTU request or reply from another slave address (CRC recomputed): the
+    manuals print their examples for ID 1, a shared bus needs other IDs."""
+    assert crc_ok(adu), adu.hex(" ")
+    return rtu(("%02X" % address) + adu[1:-2].hex())
+
+
+def readdress_ascii(body: str, address: int) -> bytes:
+    """A WTEC ASCII frame body as printed ('>01A63D8', CRC included) for another
+    address: '>' + address + command and data, new CRC, CR LF."""
+    assert body.startswith(">") and len(body) >= 7, body
+    return ascii_frame(">%02X" % address + body[3:-4])
+
+
+# ---- the manuals' example frames (tests/vectors/vectors.yaml) ---------------------
+
+VECTORS_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir,
+                            "vectors", "vectors.yaml")
+
+
+def _scalar(text):
+    text = text.strip()
+    if text == "null":
+        return None
+    if text in ("true", "false"):
+        return text == "true"
+    if len(text) >= 2 and text[0] == text[-1] == "'":
+        return text[1:-1].replace("''", "'")
+    return text
+
+
+def load_vectors(path=VECTORS_PATH):
+    """The example frames of the manuals: a list of dicts (protocol, device, what,
+    request, response, ...). vectors.yaml is a flat list of one-line scalars, so a
+    few lines of parsing replace a YAML library the standard library lacks."""
+    items = []
+    with open(path, encoding="utf-8") as f:
+        for raw in f:
+            line = raw.rstrip("\n")
+            if not line.strip() or line.lstrip().startswith("#"):
+                continue
+            if line.startswith("- "):
+                items.append({})
+                line = line[2:]
+            elif not line.startswith("  "):
+                raise ValueError("%s: unexpected line %r" % (path, line))
+            key, sep, value = line.strip().partition(": ")
+            if not sep:
+                raise ValueError("%s: line %r is not 'key: value'" % (path, line))
+            items[-1][key] = _scalar(value)
+    return items
+
+
+def vector(what, vectors=None):
+    """The example whose 'what' is @p what: exactly one must match."""
+    found = [v for v in (vectors or load_vectors()) if v["what"] == what]
+    if len(found) != 1:
+        raise KeyError("vectors.yaml has %d examples named %r" % (len(found), what))
+    return found[0]
+
+
 # ---- the simulator process -------------------------------------------------------
 
 class Sim:
@@ -127,7 +188,9 @@ class Sim:
 
 
 class SimTestCase(unittest.TestCase):
-    """Starts simulators with start(); kills them (by PID) in tearDown."""
+    """Starts simulators with start(). tearDown stops each one still running with
+    SIGTERM and requires exit code 0 (so a sanitizer build's leak and shutdown checks
+    count), killing it by PID if it does not stop."""
 
     def setUp(self):
         self._tmp = tempfile.TemporaryDirectory(prefix="fbsim-")
@@ -144,11 +207,21 @@ class SimTestCase(unittest.TestCase):
         result = getattr(getattr(self, "_outcome", None), "result", None)
         failed = result is not None and any(
             test is self for test, _ in list(result.failures) + list(result.errors))
+        unclean = []
         for sim in self.sims:
-            if failed:
+            if sim.proc.poll() is None:  # a sim the test ended itself is its business
+                try:
+                    code = sim.terminate()
+                    if code != 0:
+                        unclean.append("exit code %d after SIGTERM" % code)
+                except AssertionError as e:
+                    unclean.append(str(e))
+            if failed or unclean:
                 sys.stderr.write("---- simulator log ----\n" + sim.log_text())
             sim.close()
         self._tmp.cleanup()
+        if unclean:
+            raise AssertionError("fieldbridge-sim did not stop cleanly: " + "; ".join(unclean))
 
     def path(self, name):
         return os.path.join(self.tmp, name)

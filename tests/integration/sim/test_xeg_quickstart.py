@@ -4,7 +4,6 @@ simulator's pseudo-terminal, with and without wire-time emulation. The manual's
 (bounded), so the test takes as long as the model's motion does."""
 
 import os
-import time
 
 import simlib
 from simlib import h, read_for, transact
