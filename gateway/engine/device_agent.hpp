@@ -4,27 +4,41 @@
 /// translation of northbound requests into transactions (spec §3, §4, §5).
 ///
 ///  - Polls: every item of the profile's poll plan is submitted at its period
-///    (Priority::poll, poll_period set, reads retry_allowed); a poll is not submitted
-///    again while the previous one of the same item is queued or in flight. While the
-///    profile says in_motion(), items flagged motion are polled at the motion period
-///    (rule 5); a motion command starts that at once. A block answered with exception
-///    0x02 is split (PollPlan::on_block_rejected) and the log says so once.
+///    (Priority::poll, poll_period set, reads retry_allowed) on a fixed cadence; items
+///    due together are submitted together; a poll is not submitted again while the
+///    previous one of the same item is queued or in flight (poll_schedule.hpp).
+///    Startup items go once at start() and again when the device comes back online,
+///    retried `startup_retry` after a failure. While the profile says in_motion(),
+///    items flagged motion are polled at `motion_period` (rule 5); a motion command
+///    starts that at once, and it ends at the first motion poll sent after the last
+///    motion command finished that shows the device at rest. A poll that times out
+///    marks what it fills stale. A block answered with exception 0x02 is split
+///    (PollPlan::on_block_rejected) and the log says so once.
 ///  - Northbound requests (Modbus TCP, MQTT commands): validate() -> a local exception;
 ///    reads served from the image when every register is fresh within max_age;
 ///    otherwise to_line() payloads are submitted one after another (Priority::command
 ///    for writes with deadline now + command_ttl and delay_before_command, urgent for
-///    stops; Priority::on_demand for reads with retry_allowed), each reply applied to
-///    the image, and respond() builds the answer. Outcomes that are not replies map to
-///    Modbus exceptions: timeout / device_offline / line_down -> 0x0B (gateway target
-///    failed to respond), expired / queue_full -> 0x06 (server busy), cancelled /
-///    invalid_request -> 0x04 (server failure). spec §4 is the contract.
+///    stops; Priority::on_demand for reads with retry_allowed and the same deadline,
+///    so a client never waits forever), each reply applied to the image, and
+///    respond() builds the answer. A sequence stops at the first payload that fails
+///    or is answered with a device exception. Outcomes that are not replies map to
+///    Modbus exceptions as spec §4 and §3 rule 9 say: timeout / device_offline /
+///    line_down / expired -> 0x0B (gateway target failed to respond), queue_full ->
+///    0x06 (server busy), cancelled / invalid_request -> 0x04 (server failure).
 ///  - A reply's follow_up (XEG exception 0x04 -> FC07) is submitted as an on-demand
-///    read; a DeviceNotice is logged and reported to the notice callback.
-///  - Health: on_health(false) marks the image offline; on_health(true) marks it stale
-///    until read again.
+///    read (one at a time); a DeviceNotice is logged and reported to the notice
+///    callback.
+///  - Health: on_health(false) marks the image offline and ends motion polling;
+///    on_health(true) marks it stale until read again and polls every item at once
+///    (startup items included: the device may have been replaced).
+///  - Lifetime: transactions complete through callbacks that hold only a weak
+///    reference to the agent, so the line may complete them after the agent is gone.
+///    Destroying the agent answers its unfinished requests 0x04 (posted).
 ///
-/// Loop thread only. The agent does not own the line: it submits through a function.
+/// Loop thread only. The agent does not own the line: it submits through a function,
+/// which may complete a transaction inside the call. No I/O but one timer.
 #include <asio/io_context.hpp>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -46,6 +60,11 @@ struct DeviceAgentConfig {
     Duration command_ttl = std::chrono::milliseconds{500};    ///< deadline of commands
     Duration delay_before_command{};                          ///< rule 11
     bool polling = true;          ///< false: no polls (tests, scan)
+    /// Rule 5: the period of motion-flagged items while the device moves (the
+    /// profile's PollPeriods::motion; the profile interface does not expose it).
+    Duration motion_period = std::chrono::milliseconds{20};
+    /// A startup item (model, firmware) that failed is tried again after this.
+    Duration startup_retry = std::chrono::seconds{1};
 };
 
 using SubmitFunction = std::function<void(Transaction)>;
@@ -60,8 +79,11 @@ public:
     DeviceAgent(const DeviceAgent&) = delete;
     DeviceAgent& operator=(const DeviceAgent&) = delete;
 
-    /// Starts polling. stop() cancels the poll timers; replies that arrive later are
-    /// still applied to the image but nothing new is submitted. Idempotent.
+    /// Starts polling. stop() cancels the poll timer; replies that arrive later are
+    /// still applied to the image but nothing new is submitted: a request arriving
+    /// after stop() is answered 0x0A (gateway path unavailable), one whose next
+    /// payload is due after stop() 0x04. Both idempotent; start() after stop() does
+    /// nothing (a stopped agent is being replaced).
     void start();
     void stop();
 
@@ -84,7 +106,8 @@ public:
 
 private:
     class Impl;
-    std::unique_ptr<Impl> impl_;
+    // Shared so that transaction callbacks can hold a weak reference.
+    std::shared_ptr<Impl> impl_;
 };
 
 }  // namespace fieldbridge::engine

@@ -1,0 +1,63 @@
+#include "engine/device_agent_answers.hpp"
+
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+namespace fieldbridge::engine {
+
+using protocol::ExceptionCode;
+
+ExceptionCode exception_for(OutcomeStatus status) noexcept {
+    switch (status) {
+        case OutcomeStatus::timeout:
+        case OutcomeStatus::device_offline:
+        case OutcomeStatus::line_down:
+        case OutcomeStatus::expired: return ExceptionCode::gateway_target_failed;
+        case OutcomeStatus::queue_full: return ExceptionCode::server_device_busy;
+        case OutcomeStatus::ok:  // an ok outcome without a usable reply
+        case OutcomeStatus::cancelled:
+        case OutcomeStatus::broadcast_sent:
+        case OutcomeStatus::invalid_request: break;
+    }
+    return ExceptionCode::server_device_failure;
+}
+
+protocol::Response exception_response(const protocol::Request& request, ExceptionCode code) {
+    return protocol::ExceptionResponse{protocol::function_of(request), code};
+}
+
+std::optional<protocol::Response> answer_from_image(const protocol::Request& request, const RegisterImage& image,
+                                                    TimePoint now, Duration max_age) {
+    if (max_age <= Duration{}) {
+        return std::nullopt;
+    }
+    return std::visit(
+        [&](const auto& r) -> std::optional<protocol::Response> {
+            using T = std::decay_t<decltype(r)>;
+            if constexpr (std::is_same_v<T, protocol::ReadRegistersRequest>) {
+                const Table table = r.function == protocol::fc::read_input_registers ? Table::input : Table::holding;
+                auto values = image.read_fresh(table, r.address, r.count, now, max_age);
+                if (!values) {
+                    return std::nullopt;
+                }
+                return protocol::ReadRegistersResponse{r.function, std::move(*values)};
+            } else if constexpr (std::is_same_v<T, protocol::ReadBitsRequest>) {
+                const Table table = r.function == protocol::fc::read_coils ? Table::coils : Table::discrete_inputs;
+                const auto values = image.read_fresh(table, r.address, r.count, now, max_age);
+                if (!values) {
+                    return std::nullopt;
+                }
+                std::vector<bool> bits(values->size());
+                for (std::size_t i = 0; i < values->size(); ++i) {
+                    bits[i] = (*values)[i] != 0;
+                }
+                return protocol::ReadBitsResponse{r.function, std::move(bits)};
+            } else {
+                return std::nullopt;
+            }
+        },
+        request);
+}
+
+}  // namespace fieldbridge::engine
