@@ -17,6 +17,7 @@
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_service_manager.hpp"
+#include "scan/scan_command.hpp"
 
 #ifndef FIELDBRIDGE_VERSION
 #error "FIELDBRIDGE_VERSION must be defined by the build (gateway/daemon/CMakeLists.txt)"
@@ -66,7 +67,9 @@ using namespace fieldbridge;
 
 int main(int argc, char** argv) {
     try {
-        const daemon::CommandLine command_line(FIELDBRIDGE_VERSION);
+        daemon::CommandLine command_line(FIELDBRIDGE_VERSION);
+        scan::ScanCommand scan_command(std::cout, std::cerr);
+        command_line.add_subcommand(scan_command);
         const auto command = command_line.parse(argc, argv, std::cout, std::cerr);
         return std::visit(
             [](const auto& chosen) -> int {

@@ -69,6 +69,14 @@ void PosixSerialPort::open() {
     if (flags == -1 || ::fcntl(fd_, F_SETFL, flags | O_NONBLOCK) == -1) {
         fail("cannot make the port non-blocking", errno);
     }
+    // libmodbus leaves VMIN = 0, VTIME = 0, where a read with no data returns 0 even
+    // on a non-blocking descriptor (n_tty), indistinguishable from a hang-up. With
+    // VMIN = 1 an idle read fails with EAGAIN and 0 means hang-up, as read_some expects.
+    termios tio{};
+    if (::tcgetattr(fd_, &tio) == -1) fail("cannot read the terminal settings", errno);
+    tio.c_cc[VMIN] = 1;
+    tio.c_cc[VTIME] = 0;
+    if (::tcsetattr(fd_, TCSANOW, &tio) == -1) fail("cannot set the terminal read mode", errno);
     if (settings_.rs485) apply_rs485();
     discard_input();
 }

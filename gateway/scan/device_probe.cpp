@@ -1,0 +1,126 @@
+#include "scan/device_probe.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+#include <variant>
+
+#include "engine/profiles/profile_text.hpp"
+#include "engine/profiles/xeg_profile.hpp"
+#include "protocol/wtec_ascii_commands.hpp"
+#include "protocol/wtec_ascii_frame.hpp"
+
+namespace fieldbridge::scan {
+
+namespace {
+
+constexpr std::uint16_t presence_register = 0x0000;
+constexpr std::uint16_t xeg_model_register = 0x0600;    // seed 001 section 3.3 "EG type"
+constexpr std::uint16_t wtec_id_register = 0x0303;      // seed 003 table 2.11 "设备ID"
+constexpr std::uint16_t excd_version_register = 0x0207;  // seed 002 section 4 "ver", two registers
+
+[[nodiscard]] protocol::Request read_holding(std::uint16_t address, std::uint16_t count) {
+    return protocol::ReadRegistersRequest{protocol::fc::read_holding_registers, address, count};
+}
+
+/// The values of a register read reply; nullopt for an exception or nothing.
+[[nodiscard]] std::optional<std::vector<std::uint16_t>> values_of(const std::optional<protocol::Response>& reply) {
+    if (!reply) {
+        return std::nullopt;
+    }
+    const auto* read = std::get_if<protocol::ReadRegistersResponse>(&*reply);
+    if (read == nullptr) {
+        return std::nullopt;
+    }
+    return read->values;
+}
+
+}  // namespace
+
+ModbusProbe::ModbusProbe(std::uint8_t address) : address_(address) {}
+
+std::optional<protocol::Request> ModbusProbe::next() const {
+    switch (step_) {
+        case Step::presence: return read_holding(presence_register, 1);
+        case Step::xeg_model: return read_holding(xeg_model_register, 1);
+        case Step::wtec_id: return read_holding(wtec_id_register, 1);
+        case Step::excd_version: return read_holding(excd_version_register, 2);
+        case Step::finished: break;
+    }
+    return std::nullopt;
+}
+
+void ModbusProbe::identified(engine::DeviceType type, std::string detail) {
+    found_ = FoundDevice{address_, type, std::move(detail), holding_zero_readable_};
+    step_ = Step::finished;
+}
+
+void ModbusProbe::on_reply(const std::optional<protocol::Response>& reply) {
+    const auto values = values_of(reply);
+    switch (step_) {
+        case Step::presence:
+            if (!reply) {
+                step_ = Step::finished;  // nobody at this address
+                return;
+            }
+            holding_zero_readable_ = values.has_value() && values->size() == 1;
+            step_ = Step::xeg_model;
+            return;
+        case Step::xeg_model:
+            if (values && values->size() == 1) {
+                if (const auto model = engine::xeg_model_limits(values->front())) {
+                    identified(engine::DeviceType::hiwin_xeg,
+                               std::string{model->name} + " (model " + engine::hex_word(model->model) + ")");
+                    return;
+                }
+            }
+            step_ = Step::wtec_id;
+            return;
+        case Step::wtec_id:
+            if (values && values->size() == 1 && values->front() == address_) {
+                identified(engine::DeviceType::wtec_rtu, "device ID register 0x0303 reads " + std::to_string(address_));
+                return;
+            }
+            step_ = Step::excd_version;
+            return;
+        case Step::excd_version:
+            if (values && values->size() == 2) {
+                const std::uint32_t version = (std::uint32_t{(*values)[0]} << 16) | (*values)[1];
+                identified(engine::DeviceType::excd203mb, "ver (0x0207-0x0208) reads " + std::to_string(version));
+                return;
+            }
+            identified(engine::DeviceType::modbus,
+                       holding_zero_readable_
+                           ? "answers FC03 at 0x0000; not an XEG, WTEC-485 or EXCD203MB"
+                           : "answers FC03 at 0x0000 with an exception; not an XEG, WTEC-485 or EXCD203MB");
+            return;
+        case Step::finished: break;
+    }
+    throw std::logic_error("ModbusProbe::on_reply after the probe of address " + std::to_string(address_) +
+                           " finished; call next() first");
+}
+
+std::vector<std::uint8_t> parse_stations(protocol::ByteView rx) {
+    namespace wtec = protocol::wtec;
+    std::vector<std::uint8_t> stations;
+    while (!rx.empty()) {
+        const auto frame = wtec::scan_frame(rx);
+        if (frame.need_more() || frame.consumed == 0) {
+            break;  // an unfinished frame at the end: the window closed on it
+        }
+        if (frame.complete()) {
+            const auto reply = wtec::decode_reply(wtec::broadcast_address, wtec::ReadStations{}, frame.value);
+            if (reply.complete()) {
+                if (const auto* station = std::get_if<wtec::Station>(&reply.value)) {
+                    stations.push_back(station->address);
+                }
+            }
+        }
+        rx = rx.subspan(std::min(frame.consumed, rx.size()));
+    }
+    std::sort(stations.begin(), stations.end());
+    stations.erase(std::unique(stations.begin(), stations.end()), stations.end());
+    return stations;
+}
+
+}  // namespace fieldbridge::scan
