@@ -43,7 +43,9 @@ struct LineWorkerConfig {
     Duration reopen_max = std::chrono::seconds{30};
 };
 
-/// Called when the line goes up (port open) or down (port failed / closed).
+/// Called when the line goes up (port open) or down (port failed / closed). start()
+/// reports the first state (up, or down when the first open fails); stop() reports
+/// down when the line was up. Called on the loop thread.
 using LineStateCallback = std::function<void(bool up, TimePoint now)>;
 
 class LineWorker {

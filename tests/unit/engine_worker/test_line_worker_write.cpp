@@ -1,0 +1,101 @@
+// Non-blocking writes: a driver that takes the request a few bytes at a time, and
+// sometimes nothing, gets all of it, in order, and the reply wait starts only after
+// the last piece. The port is a SerialPort over a socketpair, so readiness is real.
+#include <sys/socket.h>
+
+#include "worker_test_support.hpp"
+
+namespace {
+
+using namespace worker_test;
+
+class ChunkedPort final : public fe::SerialPort {
+public:
+    explicit ChunkedPort(std::size_t chunk) : chunk_(chunk) { settings_.path = "chunked"; }
+    ~ChunkedPort() override {
+        close();
+        if (peer_ >= 0) ::close(peer_);
+    }
+
+    void open() override {
+        int fds[2] = {-1, -1};
+        REQUIRE(::socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK, 0, fds) == 0);
+        fd_ = fds[0];
+        peer_ = fds[1];
+    }
+    void close() noexcept override {
+        if (fd_ >= 0) ::close(fd_);
+        fd_ = -1;
+    }
+    [[nodiscard]] bool is_open() const noexcept override { return fd_ >= 0; }
+    [[nodiscard]] int native_handle() const noexcept override { return fd_; }
+    [[nodiscard]] std::size_t write_some(fp::ByteView bytes) override {
+        ++write_calls;
+        // Every other call the driver's buffer is "full".
+        accept_ = !accept_;
+        if (!accept_) return 0;
+        const ssize_t n = ::send(fd_, bytes.data(), std::min(chunk_, bytes.size()), 0);
+        if (n < 0) throw fe::SerialPortError("chunked: send failed");
+        return static_cast<std::size_t>(n);
+    }
+    [[nodiscard]] std::size_t read_some(std::span<std::uint8_t> buffer) override {
+        const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT);
+        if (n > 0) return static_cast<std::size_t>(n);
+        if (n == 0) throw fe::SerialPortError("chunked: peer closed");
+        if (errno == EAGAIN) return 0;
+        throw fe::SerialPortError("chunked: recv failed");
+    }
+    void discard_input() noexcept override {}
+    [[nodiscard]] const fe::SerialSettings& settings() const noexcept override { return settings_; }
+
+    /// The device's end of the line.
+    [[nodiscard]] int peer() const { return peer_; }
+    std::size_t write_calls = 0;
+
+private:
+    std::size_t chunk_;
+    fe::SerialSettings settings_;
+    int fd_ = -1;
+    int peer_ = -1;
+    bool accept_ = false;
+};
+
+TEST_CASE("worker: a request the driver takes in pieces goes out whole, then the reply is awaited") {
+    asio::io_context io;
+    auto owned = std::make_unique<ChunkedPort>(3);
+    ChunkedPort& port = *owned;
+    fe::LineWorkerConfig config;
+    config.name = "W";
+    fe::LineWorker worker(io, config, std::move(owned));
+    worker.scheduler().add_device(0, fe::DeviceLimits{});
+    worker.start();
+    REQUIRE(worker.line_up());
+
+    Recorder recorder;
+    const std::vector<std::uint16_t> values{1, 2, 3, 4, 5, 6, 7};
+    worker.submit(tagged(write_multiple_tx(1, 0x0020, values), recorder, "fc16"));
+    const Bytes expected =
+        fp::encode_rtu(1, fp::encode_request(fp::WriteMultipleRegistersRequest{0x0020, values}));
+
+    Bytes received;
+    REQUIRE(run_until(io, [&] {
+        std::array<std::uint8_t, 64> buffer{};
+        const ssize_t n = ::recv(port.peer(), buffer.data(), buffer.size(), MSG_DONTWAIT);
+        if (n > 0) received.insert(received.end(), buffer.begin(), buffer.begin() + n);
+        return received.size() >= expected.size();
+    }));
+    CHECK(received == expected);
+    CHECK(port.write_calls >= 2 * (expected.size() / 3));
+    CHECK(worker.master().state() == fe::MasterState::awaiting_reply);
+    CHECK(worker.master().counters().requests == 1);
+
+    const Bytes reply = fp::encode_rtu(
+        1, fp::encode_response(fp::WriteMultipleResponse{fp::fc::write_multiple_registers, 0x0020, 7}));
+    REQUIRE(::send(port.peer(), reply.data(), reply.size(), 0) == static_cast<ssize_t>(reply.size()));
+    REQUIRE(run_until(io, [&] { return recorder.total() == 1; }));
+    CHECK(recorder.status("fc16") == OutcomeStatus::ok);
+    CHECK(recorder.outcome("fc16").attempts == 1);
+    worker.stop();
+}
+
+}  // namespace
