@@ -112,6 +112,7 @@ void set(T& target, const Field<T>& field) {
     set(line.response_timeout, raw.response_timeout);
     line.byte_timeout = raw.byte_timeout.value_or(default_byte_timeout(line));
     set(line.turnaround, raw.turnaround);
+    set(line.broadcast_delay, raw.broadcast_delay);
     line.read_retries = narrow<unsigned>(raw.read_retries, line.read_retries);
     line.offline_after = narrow<unsigned>(raw.offline_after, line.offline_after);
     line.offline_backoff = build_backoff(raw.offline_backoff, line.offline_backoff);

@@ -208,8 +208,15 @@ struct LineConfig {
     milliseconds byte_timeout{5};
     static constexpr milliseconds default_byte_timeout{5};
     static constexpr Range<milliseconds> byte_timeout_range{milliseconds{1}, seconds{1}};
-    milliseconds turnaround{1};  ///< guard after a reply / broadcast before the next request
+    /// Guard after a reply before the next request, on top of the 3.5-character
+    /// silence that is always kept (they overlap). 0: the silence alone, which is
+    /// what the line's physical rate assumes (spec section 9).
+    milliseconds turnaround{0};
     static constexpr Range<milliseconds> turnaround_range{milliseconds{0}, seconds{1}};
+    /// After a broadcast, before the next request: every slave must have acted on it
+    /// (Modbus over Serial Line V1.02, 2.4.1: "turnaround delay", typically 100-200 ms).
+    milliseconds broadcast_delay{100};
+    static constexpr Range<milliseconds> broadcast_delay_range{milliseconds{0}, seconds{10}};
     unsigned read_retries = 1;  ///< writes are never retried (spec section 3 rule 6)
     static constexpr Range<std::int64_t> read_retries_range{0, 5};
     unsigned offline_after = 3;  ///< consecutive timeouts

@@ -76,7 +76,7 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
 RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "port", "baud", "parity", "data_bits", "stop_bits", "rs485", "local_echo",
-                         "response_timeout", "byte_timeout", "turnaround", "read_retries", "offline_after",
+                         "response_timeout", "byte_timeout", "turnaround", "broadcast_delay", "read_retries", "offline_after",
                          "offline_backoff", "broadcast_unit", "devices"},
                         sink);
     RawLine raw;
@@ -93,6 +93,7 @@ RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     raw.response_timeout = read_duration(map, "response_timeout");
     raw.byte_timeout = read_duration(map, "byte_timeout");
     raw.turnaround = read_duration(map, "turnaround");
+    raw.broadcast_delay = read_duration(map, "broadcast_delay");
     raw.read_retries = read_int(map, "read_retries");
     raw.offline_after = read_int(map, "offline_after");
     raw.offline_backoff = parse_backoff(map.child("offline_backoff"), sink);

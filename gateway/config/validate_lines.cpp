@@ -66,6 +66,7 @@ void check_timing(const RawLine& line, DiagnosticSink& sink) {
         }
     }
     check_range(sink, line.turnaround, LineConfig::turnaround_range);
+    check_range(sink, line.broadcast_delay, LineConfig::broadcast_delay_range);
     check_range(sink, line.read_retries, LineConfig::read_retries_range);
     check_range(sink, line.offline_after, LineConfig::offline_after_range);
     check_backoff(sink, line.offline_backoff, LineConfig{}.offline_backoff);

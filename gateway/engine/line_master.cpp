@@ -109,8 +109,8 @@ void LineMaster::transition(MasterState next, TimePoint now, const char* why) {
             break;
         case MasterState::settling_broadcast:
             // Modbus over Serial Line V1.02, 2.1: after a broadcast the master waits
-            // the turnaround delay so every slave has processed it, on top of t3.5.
-            settle_until_ = last_tx_end_ + timing_.t3_5() + config_.turnaround;
+            // a turnaround delay so every slave has processed it, on top of t3.5.
+            settle_until_ = last_tx_end_ + timing_.t3_5() + config_.broadcast_delay;
             break;
         case MasterState::complete:
             break;

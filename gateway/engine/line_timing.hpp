@@ -87,9 +87,12 @@ struct LineTimingConfig {
     Duration response_timeout = std::chrono::milliseconds{100};
     /// Modbus-RTU: longest gap between two bytes of one reply; longer ends the frame.
     Duration byte_timeout = std::chrono::milliseconds{5};
-    /// Guard after a reply (from its last byte) and after a broadcast (on top of the
-    /// silence) before the next request.
-    Duration turnaround = std::chrono::milliseconds{1};
+    /// Guard after a reply (from its last byte) before the next request; it overlaps
+    /// the t3.5 silence rather than adding to it.
+    Duration turnaround = std::chrono::milliseconds{0};
+    /// After a broadcast, on top of t3.5, before the next request (Modbus over Serial
+    /// Line V1.02, 2.4.1: every slave must have processed it).
+    Duration broadcast_delay = std::chrono::milliseconds{100};
     /// 2-wire adapter that echoes what it sends: discard exactly the bytes sent first.
     bool local_echo = false;
     /// WTEC-485 ASCII (seed 003, 1.1): inter-character timeout t = 5 ms, frame timeout

@@ -161,7 +161,8 @@ upstreams:
     CHECK_FALSE(line.local_echo);
     CHECK(line.response_timeout == 100ms);
     CHECK(line.byte_timeout == 5ms);
-    CHECK(line.turnaround == 1ms);
+    CHECK(line.turnaround == 0ms);
+    CHECK(line.broadcast_delay == 100ms);
     CHECK(line.read_retries == 1);
     CHECK(line.offline_after == 3);
     CHECK(line.offline_backoff == Backoff{1s, 30s});

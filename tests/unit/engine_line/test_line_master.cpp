@@ -261,7 +261,7 @@ TEST_CASE("master: a broadcast is written, the line settles, no reply is awaited
     const Bytes request = send(master, std::move(broadcast), t0, written);
     CHECK(request.front() == 0x00);
     CHECK(master.state() == fe::MasterState::settling_broadcast);
-    const TimePoint settled = written + master.timing().wire_time(request.size()) + t35 + 1ms;
+    const TimePoint settled = written + master.timing().wire_time(request.size()) + t35 + master.config().broadcast_delay;
     CHECK(expect_wait(master, written) == settled);
     master.on_bytes(Bytes{0x00, 0x06}, written + 1ms);  // nobody answers a broadcast: noise
     CHECK(expect_wait(master, written + 1ms) == settled);
@@ -282,7 +282,7 @@ TEST_CASE("master: the EXCD203MB broadcast address 0xFF; echo of a broadcast is 
     const Bytes request = send(master, std::move(broadcast), t0, written);
     CHECK(request.front() == 0xFF);
     master.on_bytes(request, written + 1ms);
-    const TimePoint settled = written + master.timing().wire_time(request.size()) + t35 + 1ms;
+    const TimePoint settled = written + master.timing().wire_time(request.size()) + t35 + master.config().broadcast_delay;
     CHECK(expect_finished(master, settled).outcome.status == OutcomeStatus::broadcast_sent);
     CHECK(master.counters().garbage_bytes == 0);
     CHECK(master.counters().echo_mismatch == 0);

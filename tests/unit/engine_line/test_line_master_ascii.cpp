@@ -132,7 +132,7 @@ TEST_CASE("ascii: a broadcast to station 00 is not answered and settles") {
     const Bytes request = send(master, ascii_tx(fe::broadcast_device, 0, wtec::Home{}), t0, written);
     CHECK(std::string(request.begin(), request.begin() + 4) == ">00G");
     const TimePoint settled =
-        written + master.timing().wire_time(request.size()) + master.timing().t3_5() + 1ms;
+        written + master.timing().wire_time(request.size()) + master.timing().t3_5() + master.config().broadcast_delay;
     CHECK(expect_wait(master, written) == settled);
     CHECK(expect_finished(master, settled).outcome.status == OutcomeStatus::broadcast_sent);
 }
