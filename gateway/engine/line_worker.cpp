@@ -180,6 +180,15 @@ private:
                 if (!read_input()) continue;
                 now = Clock::now();
             }
+            if (master_.state() == MasterState::awaiting_reply || master_.state() == MasterState::discarding_echo) {
+                // next_action() decides the timeout: take in what arrived first. A drive
+                // posted by a submission can run before the port's readiness handler when
+                // the loop was held up (a slow handler, a busy machine); without this a
+                // reply already in the driver's buffer would be judged a timeout, and a
+                // write answered in time reported as failed.
+                if (!read_input()) continue;
+                now = Clock::now();
+            }
             LineAction action = master_.next_action(now);
             if (auto* finished = std::get_if<line_action::Finished>(&action)) {
                 scheduler_.finished(std::move(finished->transaction), finished->outcome, now);

@@ -203,6 +203,10 @@ void XegProfile::apply_other(const protocol::Request& sent, const protocol::Resp
         result.status = ApplyStatus::not_applicable;
         return;
     }
+    // 0x00 is "no error": nothing to tell an operator (a client's own FC07 read).
+    if (status_reply->status == 0) {
+        return;
+    }
     result.notice = DeviceNotice{status_reply->status,
                                  "exception status " + hex_byte(status_reply->status) + ": " +
                                      std::string{xeg_exception_status_text(status_reply->status)}};

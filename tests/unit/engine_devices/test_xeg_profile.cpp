@@ -270,6 +270,10 @@ TEST_CASE("xeg: exception 0x04 asks for FC07, whose status is decoded") {
     REQUIRE(status.notice.has_value());
     CHECK(status.notice->code == 0x02);
     CHECK(status.notice->text == "exception status 0x02: emergency stop");
+    // 0x00 is "no error": applied, nothing to report.
+    const auto clear = x.profile.apply(*r.follow_up, modbus(fp::ReadExceptionStatusResponse{0x00}), x.image, t0());
+    CHECK(clear.status == fe::ApplyStatus::applied);
+    CHECK_FALSE(clear.notice.has_value());
     CHECK(fe::xeg_exception_status_text(0x12) == "reset error");
     CHECK(fe::xeg_exception_status_text(0x99) == "exception status not in the manual");
 
