@@ -1,0 +1,39 @@
+#pragma once
+/// @file access_control.hpp
+/// Per-request access control of the Modbus TCP server (spec section 4): what a
+/// request touches (function code and address ranges, read straight from the PDU's
+/// header fields) and whether the configured rules let the client do it.
+///
+/// Pure: no I/O, no state. The PDU is not validated here; a PDU too short to carry
+/// its address fields has no range, and the rules treat it as a request without
+/// registers (the target then rejects it as malformed).
+#include <cstdint>
+#include <optional>
+
+#include "config/config.hpp"
+#include "protocol/bytes.hpp"
+
+namespace fieldbridge::northbound::modbus_tcp {
+
+/// What a request touches.
+struct RequestScope {
+    std::uint8_t function = 0;
+    /// FC01-06, 0F, 10: the addressed coils / inputs / registers. FC17: the read range.
+    std::optional<config::RegisterRange> first;
+    /// FC17 only: the write range.
+    std::optional<config::RegisterRange> second;
+    bool operator==(const RequestScope&) const = default;
+};
+
+/// Derives the scope of a request PDU (function code first). A quantity of 0 counts
+/// as the one addressed register and a range running past 0xFFFF ends at 0xFFFF, so
+/// a malformed quantity can never make a request look smaller than what it names.
+[[nodiscard]] RequestScope request_scope(protocol::ByteView pdu) noexcept;
+
+/// The allow-list is checked at accept (ModbusTcpConfig::client_allowed); this is
+/// the per-request rule check: the first matching rule decides, no match allows.
+/// FC17 is allowed only when both its read and its write range are allowed.
+[[nodiscard]] bool request_allowed(const config::ModbusTcpConfig& config, const config::IpAddress& client,
+                                   std::uint8_t unit, const RequestScope& scope) noexcept;
+
+}  // namespace fieldbridge::northbound::modbus_tcp

@@ -1,0 +1,368 @@
+// One Modbus TCP client connection. MBAP layout: Modbus Messaging on TCP/IP
+// Implementation Guide V1.0b section 3.1.3 (protocol/mbap_frame.hpp frames it).
+#include "northbound/modbus_tcp/connection.hpp"
+
+#include <asio/post.hpp>
+#include <asio/write.hpp>
+#include <cstring>
+#include <exception>
+#include <fmt/format.h>
+#include <utility>
+
+#include "northbound/modbus_tcp/access_control.hpp"
+#include "protocol/mbap_frame.hpp"
+#include "protocol/modbus_pdu.hpp"
+
+namespace fieldbridge::northbound::modbus_tcp {
+namespace {
+
+using engine::LogLevel;
+using Clock = std::chrono::steady_clock;
+
+template <class... Args>
+void log(const engine::LogSink& sink, LogLevel level, fmt::format_string<Args...> format, Args&&... args) {
+    if (sink.enabled(level)) sink(level, fmt::format(format, std::forward<Args>(args)...));
+}
+
+/// Appends one MBAP frame (header + PDU) to @p out without a temporary buffer:
+/// responses of one connection are gathered into one write.
+void append_mbap(protocol::Bytes& out, std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
+    protocol::put_u16_be(out, transaction_id);
+    protocol::put_u16_be(out, 0);  // protocol identifier: Modbus
+    protocol::put_u16_be(out, static_cast<std::uint16_t>(pdu.size() + 1));
+    out.push_back(unit);
+    out.insert(out.end(), pdu.begin(), pdu.end());
+}
+
+[[nodiscard]] std::uint64_t& close_counter(ServerStats& stats, CloseReason reason) noexcept {
+    switch (reason) {
+        case CloseReason::peer: return stats.closed_by_peer;
+        case CloseReason::malformed: return stats.closed_malformed;
+        case CloseReason::output_overflow: return stats.closed_output_overflow;
+        case CloseReason::idle: return stats.closed_idle;
+        case CloseReason::io_error:
+        case CloseReason::not_allowed:
+        case CloseReason::server_stop: break;
+    }
+    return stats.closed_io_error;
+}
+
+}  // namespace
+
+const char* to_string(CloseReason reason) noexcept {
+    switch (reason) {
+        case CloseReason::peer: return "closed by the client";
+        case CloseReason::io_error: return "socket error";
+        case CloseReason::malformed: return "malformed MBAP frame";
+        case CloseReason::output_overflow: return "client does not read its responses";
+        case CloseReason::idle: return "idle timeout";
+        case CloseReason::not_allowed: return "client no longer in the allow-list";
+        case CloseReason::server_stop: return "server stopping";
+    }
+    return "?";
+}
+
+Connection::Connection(std::shared_ptr<ConnectionContext> context, asio::ip::tcp::socket socket, ClientRef client,
+                       std::string peer)
+    : context_(std::move(context)),
+      socket_(std::move(socket)),
+      idle_timer_(socket_.get_executor()),
+      client_(client),
+      peer_(std::move(peer)),
+      rx_(context_->limits.read_buffer_bytes),
+      slots_(context_->limits.max_outstanding) {
+    free_slots_.reserve(slots_.size());
+    for (std::size_t i = slots_.size(); i > 0; --i) free_slots_.push_back(static_cast<std::uint16_t>(i - 1));
+}
+
+Connection::~Connection() = default;
+
+void Connection::start() {
+    last_activity_ = Clock::now();
+    arm_idle_timer();
+    read();
+}
+
+void Connection::read() {
+    if (closed_ || reading_ || outstanding_ >= slots_.size() || rx_end_ == rx_.size()) return;
+    reading_ = true;
+    socket_.async_read_some(asio::buffer(rx_.data() + rx_end_, rx_.size() - rx_end_),
+                            [self = shared_from_this()](const asio::error_code& error, std::size_t count) {
+                                self->on_read(error, count);
+                            });
+}
+
+void Connection::on_read(const asio::error_code& error, std::size_t count) {
+    reading_ = false;
+    if (closed_) {
+        release_read_buffer();
+        return;
+    }
+    if (error) {
+        const bool by_peer = error == asio::error::eof || error == asio::error::connection_reset;
+        if (!by_peer) {
+            log(context_->log, LogLevel::info, "Modbus TCP: client {}: read failed: {}", peer_, error.message());
+        }
+        close(by_peer ? CloseReason::peer : CloseReason::io_error);
+        return;
+    }
+    rx_end_ += count;
+    last_activity_ = Clock::now();
+    process();
+    read();
+}
+
+void Connection::process() {
+    while (!closed_ && outstanding_ < slots_.size() && buffered() > 0) {
+        const protocol::ByteView stream(rx_.data() + rx_begin_, buffered());
+        const auto frame = protocol::decode_mbap(stream);
+        if (frame.need_more()) break;
+        if (frame.malformed()) {
+            log(context_->log, LogLevel::warning,
+                "Modbus TCP: client {} sent a malformed MBAP header ({}); closing its connection", peer_,
+                protocol::to_string(frame.error));
+            close(CloseReason::malformed);
+            return;
+        }
+        rx_begin_ += frame.consumed;
+        dispatch(frame.value.transaction_id, frame.value.unit_id, frame.value.pdu);
+    }
+    // Keep the partial frame at the front so the buffer always has room for a whole one.
+    if (rx_begin_ == rx_end_) {
+        rx_begin_ = rx_end_ = 0;
+    } else if (rx_begin_ > 0 && rx_end_ + protocol::mbap_header_size + protocol::mbap_max_length > rx_.size()) {
+        std::memmove(rx_.data(), rx_.data() + rx_begin_, buffered());
+        rx_end_ -= rx_begin_;
+        rx_begin_ = 0;
+    }
+}
+
+void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
+    ConnectionContext& context = *context_;
+    ++context.stats.requests;
+    const RequestScope scope = request_scope(pdu);
+    if (!request_allowed(*context.config, client_.address, unit, scope)) {
+        ++context.stats.denied;
+        log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} function {} denied by an access rule",
+            peer_, unit, scope.function);
+        respond_exception(transaction_id, unit, scope.function,
+                          static_cast<std::uint8_t>(protocol::ExceptionCode::illegal_function));
+        return;
+    }
+    UnitTarget* target = context.routes.find(unit);
+    if (target == nullptr) {
+        ++context.stats.unknown_unit;
+        log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} has no route", peer_, unit);
+        respond_exception(transaction_id, unit, scope.function,
+                          static_cast<std::uint8_t>(protocol::ExceptionCode::gateway_path_unavailable));
+        return;
+    }
+    const std::uint16_t index = free_slots_.back();
+    free_slots_.pop_back();
+    Slot& slot = slots_[index];
+    slot.busy = true;
+    slot.transaction_id = transaction_id;
+    slot.unit = unit;
+    slot.function = scope.function;
+    const std::uint32_t generation = slot.generation;
+    ++outstanding_;
+    forwarded_ = true;
+    try {
+        // The handler keeps this connection (not its socket: close() releases that)
+        // so that an answer arriving after the close is counted and dropped here.
+        target->handle(unit, pdu, client_,
+                       [self = shared_from_this(), index, generation](protocol::Bytes response) {
+                           self->complete(index, generation, std::move(response));
+                       });
+    } catch (const std::exception& e) {
+        ++context.stats.target_failures;
+        log(context.log, LogLevel::error, "Modbus TCP: the target of unit {} failed on a request of {}: {}", unit,
+            peer_, e.what());
+        if (slot.busy && slot.generation == generation) {
+            complete(index, generation,
+                     protocol::Bytes{static_cast<std::uint8_t>(scope.function | protocol::fc::exception_flag),
+                                     static_cast<std::uint8_t>(protocol::ExceptionCode::server_device_failure)});
+        }
+    }
+}
+
+void Connection::complete(std::uint16_t index, std::uint32_t generation, protocol::Bytes response_pdu) {
+    Slot& slot = slots_[index];
+    if (!slot.busy || slot.generation != generation) return;  // answered twice: the first answer stands
+    if (closed_) {
+        ++context_->stats.late_responses;
+        slot.busy = false;
+        ++slot.generation;
+        return;
+    }
+    slot.busy = false;
+    ++slot.generation;
+    free_slots_.push_back(index);
+    const bool was_full = outstanding_ == slots_.size();
+    --outstanding_;
+    if (response_pdu.empty() || response_pdu.size() > protocol::max_pdu_size) {
+        ++context_->stats.target_failures;
+        log(context_->log, LogLevel::error,
+            "Modbus TCP: the target of unit {} answered a PDU of {} bytes (1..{} allowed); sending exception 0x04",
+            slot.unit, response_pdu.size(), protocol::max_pdu_size);
+        respond_exception(slot.transaction_id, slot.unit, slot.function,
+                          static_cast<std::uint8_t>(protocol::ExceptionCode::server_device_failure));
+    } else {
+        respond(slot.transaction_id, slot.unit, response_pdu);
+    }
+    if (was_full) schedule_resume();
+}
+
+void Connection::respond_exception(std::uint16_t transaction_id, std::uint8_t unit, std::uint8_t function,
+                                   std::uint8_t code) {
+    // Built by hand rather than with encode_exception(): a request may carry a
+    // function code >= 0x80 and still gets an answer.
+    const std::uint8_t pdu[2] = {static_cast<std::uint8_t>(function | protocol::fc::exception_flag), code};
+    respond(transaction_id, unit, protocol::ByteView(pdu, 2));
+}
+
+void Connection::respond(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
+    ServerStats& stats = context_->stats;
+    ++stats.responses;
+    if (pdu.size() >= 2 && (pdu[0] & protocol::fc::exception_flag) != 0) ++stats.exceptions_by_code[pdu[1]];
+    if (close_scheduled_) return;
+    append_mbap(out_pending_, transaction_id, unit, pdu);
+    if (out_pending_.size() + out_sending_.size() > context_->limits.max_output_bytes) {
+        log(context_->log, LogLevel::warning,
+            "Modbus TCP: client {} does not read its responses ({} bytes waiting); closing its connection", peer_,
+            out_pending_.size() + out_sending_.size());
+        schedule_close(CloseReason::output_overflow);
+        return;
+    }
+    write();
+}
+
+void Connection::write() {
+    if (writing_ || closed_ || out_pending_.empty()) return;
+    writing_ = true;
+    out_sending_.swap(out_pending_);
+    asio::async_write(socket_, asio::buffer(out_sending_),
+                      [self = shared_from_this()](const asio::error_code& error, std::size_t /*sent*/) {
+                          self->on_write(error);
+                      });
+}
+
+void Connection::on_write(const asio::error_code& error) {
+    writing_ = false;
+    if (closed_) {
+        out_sending_ = protocol::Bytes{};
+        return;
+    }
+    if (error) {
+        const bool by_peer = error == asio::error::broken_pipe || error == asio::error::connection_reset;
+        if (!by_peer) {
+            log(context_->log, LogLevel::info, "Modbus TCP: client {}: write failed: {}", peer_, error.message());
+        }
+        close(by_peer ? CloseReason::peer : CloseReason::io_error);
+        return;
+    }
+    out_sending_.clear();  // keeps its capacity for the next batch
+    last_activity_ = Clock::now();
+    write();
+}
+
+void Connection::schedule_resume() {
+    if (resume_scheduled_ || closed_) return;
+    resume_scheduled_ = true;
+    asio::post(socket_.get_executor(), [self = shared_from_this()] {
+        self->resume_scheduled_ = false;
+        if (self->closed_) return;
+        self->process();
+        self->read();
+    });
+}
+
+void Connection::schedule_close(CloseReason reason) {
+    if (close_scheduled_ || closed_) return;
+    close_scheduled_ = true;
+    asio::post(socket_.get_executor(), [self = shared_from_this(), reason] { self->close(reason); });
+}
+
+void Connection::arm_idle_timer() {
+    const auto timeout = context_->config->idle_timeout;
+    if (closed_ || idle_waiting_ || timeout.count() <= 0) return;
+    // The timer is not moved on every request: when it fires it looks at the last
+    // activity and waits again for the rest of the timeout.
+    const auto now = Clock::now();
+    const auto deadline = outstanding_ > 0 ? now + timeout : std::max(last_activity_ + timeout, now);
+    idle_timer_.expires_at(deadline);
+    idle_waiting_ = true;
+    idle_timer_.async_wait([self = shared_from_this()](const asio::error_code& error) { self->on_idle_timer(error); });
+}
+
+void Connection::restart_idle_timer() {
+    if (closed_) return;
+    if (idle_waiting_) {
+        idle_timer_.cancel();  // on_idle_timer re-arms with the new timeout
+    } else {
+        arm_idle_timer();
+    }
+}
+
+void Connection::on_idle_timer(const asio::error_code& /*error*/) {
+    idle_waiting_ = false;
+    if (closed_) return;
+    const auto timeout = context_->config->idle_timeout;
+    if (timeout.count() <= 0) return;
+    // A client waiting for an answer is not idle: the target owes it one.
+    if (outstanding_ == 0 && Clock::now() >= last_activity_ + timeout) {
+        if (buffered() > 0) {
+            log(context_->log, LogLevel::warning,
+                "Modbus TCP: client {} left a frame incomplete ({} bytes) for {} ms; closing its connection", peer_,
+                buffered(), timeout.count());
+            close(CloseReason::malformed);
+        } else {
+            log(context_->log, LogLevel::info, "Modbus TCP: client {} idle for {} ms; closing its connection", peer_,
+                timeout.count());
+            close(CloseReason::idle);
+        }
+        return;
+    }
+    arm_idle_timer();
+}
+
+void Connection::close(CloseReason reason) {
+    if (closed_) return;
+    closed_ = true;
+    const auto keep_alive = shared_from_this();  // on_closed drops the server's reference
+    ConnectionContext& context = *context_;
+    --context.stats.connections_open;
+    if (reason != CloseReason::server_stop && reason != CloseReason::not_allowed) ++close_counter(context.stats, reason);
+    log(context.log, reason == CloseReason::peer ? LogLevel::debug : LogLevel::info,
+        "Modbus TCP: connection {} from {} closed: {}", client_.connection, peer_, to_string(reason));
+    asio::error_code ignored;
+    idle_timer_.cancel();
+    socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+    socket_.close(ignored);
+    // A target may hold this object a while longer (until it answers or drops the
+    // handler): keep only what a late answer needs.
+    // (Buffers of a read or write in flight are released by its aborted handler.)
+    out_pending_ = protocol::Bytes{};
+    if (!reading_) release_read_buffer();
+    if (!writing_) out_sending_ = protocol::Bytes{};
+    if (forwarded_) notify_targets();
+    if (context.on_closed) context.on_closed(client_.connection);
+}
+
+void Connection::release_read_buffer() {
+    rx_ = std::vector<std::uint8_t>{};
+    rx_begin_ = rx_end_ = 0;
+}
+
+void Connection::notify_targets() {
+    for (UnitTarget* target : context_->routes.targets()) {
+        try {
+            target->client_closed(client_.connection);
+        } catch (const std::exception& e) {
+            log(context_->log, LogLevel::error, "Modbus TCP: a target failed to drop connection {}: {}",
+                client_.connection, e.what());
+        }
+    }
+}
+
+}  // namespace fieldbridge::northbound::modbus_tcp

@@ -1,0 +1,84 @@
+#include "northbound/modbus_tcp/listen_socket.hpp"
+
+#include <asio/ip/v6_only.hpp>
+#include <cerrno>
+#include <fmt/format.h>
+
+#include "northbound/modbus_tcp/modbus_tcp_error.hpp"
+
+namespace fieldbridge::northbound::modbus_tcp {
+
+/// Ports below this need privileges on Linux (net.ipv4.ip_unprivileged_port_start).
+constexpr std::uint16_t first_unprivileged_port = 1024;
+
+std::string listen_advice(const asio::error_code& error, const config::ListenAddress& address) {
+    if (error == asio::error::address_in_use) {
+        return fmt::format("another process listens on port {} (see `ss -ltnp 'sport = :{}'`), or another "
+                           "modbus_tcp.listen entry overlaps it; stop that process or choose another port",
+                           address.port, address.port);
+    }
+    if (error == asio::error::access_denied || error.value() == EACCES || error.value() == EPERM) {
+        if (address.port < first_unprivileged_port) {
+            return fmt::format("port {} is privileged: run with CAP_NET_BIND_SERVICE (the systemd unit sets "
+                               "AmbientCapabilities=CAP_NET_BIND_SERVICE) or listen on a port from 1024 up",
+                               address.port);
+        }
+        return "the system refused the bind (a security policy?); check the journal for an LSM denial";
+    }
+    if (error.value() == EADDRNOTAVAIL) {
+        return fmt::format("{} is not an address of this machine; use one of its interface addresses, or 0.0.0.0 "
+                           "/ :: for all",
+                           address.host);
+    }
+    if (error == asio::error::address_family_not_supported) {
+        return "IPv6 is disabled on this machine; listen on an IPv4 address";
+    }
+    return "check modbus_tcp.listen";
+}
+
+asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::ListenAddress& address, bool v6_only) {
+    asio::error_code error;
+    const auto ip = asio::ip::make_address(address.host, error);
+    if (error) {
+        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {}: {} is not an IP address",
+                                         address.to_string(), address.host));
+    }
+    const asio::ip::tcp::endpoint endpoint(ip, address.port);
+    asio::ip::tcp::acceptor acceptor(io);
+    const char* step = "open";
+    acceptor.open(endpoint.protocol(), error);
+    if (!error) {
+        // A restarted gateway must rebind at once despite connections in TIME_WAIT.
+        acceptor.set_option(asio::ip::tcp::acceptor::reuse_address(true), error);
+    }
+    if (!error && ip.is_v6()) acceptor.set_option(asio::ip::v6_only(v6_only), error);
+    if (!error) {
+        step = "bind";
+        acceptor.bind(endpoint, error);
+    }
+    if (!error) {
+        step = "listen";
+        acceptor.listen(asio::socket_base::max_listen_connections, error);
+    }
+    if (error) {
+        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {} ({} failed: {}): {}", address.to_string(),
+                                         step, error.message(), listen_advice(error, address)));
+    }
+    return acceptor;
+}
+
+config::IpAddress to_ip_address(const asio::ip::address& address) {
+    if (address.is_v4()) return config::ipv4_mapped(address.to_v4().to_uint());
+    const auto bytes = address.to_v6().to_bytes();
+    config::IpAddress out{};
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = bytes[i];
+    return out;
+}
+
+std::string to_string(const asio::ip::tcp::endpoint& endpoint) {
+    const auto address = endpoint.address();
+    if (address.is_v6()) return fmt::format("[{}]:{}", address.to_string(), endpoint.port());
+    return fmt::format("{}:{}", address.to_string(), endpoint.port());
+}
+
+}  // namespace fieldbridge::northbound::modbus_tcp

@@ -1,0 +1,244 @@
+#include "northbound/modbus_tcp/server.hpp"
+
+#include <algorithm>
+#include <asio/steady_timer.hpp>
+#include <fmt/format.h>
+#include <utility>
+
+#include "northbound/modbus_tcp/listen_socket.hpp"
+#include "northbound/modbus_tcp/modbus_tcp_error.hpp"
+#include "protocol/mbap_frame.hpp"
+
+namespace fieldbridge::northbound::modbus_tcp {
+namespace {
+
+using engine::LogLevel;
+using Clock = std::chrono::steady_clock;
+
+constexpr auto refusal_log_interval = std::chrono::seconds{10};
+/// Out of file descriptors or memory: accepting again at once would spin.
+constexpr auto accept_retry_delay = std::chrono::milliseconds{100};
+
+template <class... Args>
+void log(const engine::LogSink& sink, LogLevel level, fmt::format_string<Args...> format, Args&&... args) {
+    if (sink.enabled(level)) sink(level, fmt::format(format, std::forward<Args>(args)...));
+}
+
+[[nodiscard]] ServerLimits usable(ServerLimits limits) {
+    limits.max_outstanding = std::clamp<std::size_t>(limits.max_outstanding, 1, 0xFFFF);
+    // The buffer must hold a whole frame behind a partial one being compacted.
+    limits.read_buffer_bytes = std::max(limits.read_buffer_bytes, 2 * (protocol::mbap_header_size + protocol::mbap_max_length));
+    return limits;
+}
+
+/// An IPv6 listener must leave IPv4 to an IPv4 listener on the same port.
+[[nodiscard]] bool shares_port_with_ipv4(const config::ModbusTcpConfig& config, const config::ListenAddress& address) {
+    return std::any_of(config.listen.begin(), config.listen.end(), [&](const config::ListenAddress& other) {
+        return !other.is_ipv6() && other.port == address.port;
+    });
+}
+
+}  // namespace
+
+/// Shared with its pending accept: after stop() or destruction `server` is null and
+/// an accept that completes late only closes its socket.
+struct ModbusTcpServer::Listener {
+    Listener(ModbusTcpServer& owner, asio::ip::tcp::acceptor socket, std::string text)
+        : server(&owner), acceptor(std::move(socket)), retry(acceptor.get_executor()), name(std::move(text)) {}
+    ModbusTcpServer* server;
+    asio::ip::tcp::acceptor acceptor;
+    asio::steady_timer retry;
+    std::string name;
+};
+
+ModbusTcpServer::ModbusTcpServer(asio::io_context& io, std::shared_ptr<const config::ModbusTcpConfig> config,
+                                 engine::LogSink log, ServerLimits limits)
+    : io_(io), context_(std::make_shared<ConnectionContext>()) {
+    context_->config = std::move(config);
+    context_->log = std::move(log);
+    context_->limits = usable(limits);
+    context_->on_closed = [this](std::uint64_t connection) { connections_.erase(connection); };
+}
+
+ModbusTcpServer::~ModbusTcpServer() {
+    stop();
+    context_->on_closed = nullptr;
+}
+
+std::vector<std::shared_ptr<ModbusTcpServer::Listener>> ModbusTcpServer::open_listeners(
+    const config::ModbusTcpConfig& config) {
+    std::vector<std::shared_ptr<Listener>> opened;
+    try {
+        for (const auto& address : config.listen) {
+            auto acceptor = open_listen_socket(io_, address, address.is_ipv6() && shares_port_with_ipv4(config, address));
+            opened.push_back(std::make_shared<Listener>(*this, std::move(acceptor), address.to_string()));
+        }
+    } catch (...) {
+        for (auto& listener : opened) {
+            listener->server = nullptr;
+            asio::error_code ignored;
+            listener->acceptor.close(ignored);
+        }
+        throw;
+    }
+    return opened;
+}
+
+void ModbusTcpServer::start() {
+    if (running()) return;
+    if (context_->config->listen.empty()) {
+        throw ModbusTcpError("Modbus TCP: no listen address configured; add one to modbus_tcp.listen");
+    }
+    listeners_ = open_listeners(*context_->config);
+    bound_ = context_->config->listen;
+    start_accepting();
+}
+
+void ModbusTcpServer::start_accepting() {
+    for (const auto& listener : listeners_) {
+        log(context_->log, LogLevel::info, "Modbus TCP: listening on {} (bound {})", listener->name,
+            to_string(listener->acceptor.local_endpoint()));
+        accept(listener);
+    }
+}
+
+void ModbusTcpServer::close_listeners() {
+    for (auto& listener : listeners_) {
+        listener->server = nullptr;
+        asio::error_code ignored;
+        listener->acceptor.close(ignored);
+        listener->retry.cancel();
+    }
+    listeners_.clear();
+}
+
+void ModbusTcpServer::stop() {
+    close_listeners();
+    // close() removes each connection from the map: close from a copy.
+    std::vector<std::shared_ptr<Connection>> open;
+    open.reserve(connections_.size());
+    for (auto& [id, connection] : connections_) open.push_back(connection);
+    for (auto& connection : open) connection->close(CloseReason::server_stop);
+    connections_.clear();
+}
+
+void ModbusTcpServer::accept(const std::shared_ptr<Listener>& listener) {
+    listener->acceptor.async_accept([listener](const asio::error_code& error, asio::ip::tcp::socket socket) {
+        ModbusTcpServer* server = listener->server;
+        if (server == nullptr || error == asio::error::operation_aborted) return;
+        if (!error) {
+            server->on_accepted(std::move(socket));
+            server->accept(listener);
+            return;
+        }
+        const bool exhausted = error == asio::error::no_descriptors || error == asio::error::no_buffer_space ||
+                               error == asio::error::no_memory || error.value() == ENFILE;
+        log(server->context_->log, LogLevel::warning, "Modbus TCP: accept on {} failed: {}{}", listener->name,
+            error.message(), exhausted ? "; retrying shortly (raise LimitNOFILE or lower max_connections)" : "");
+        if (!exhausted) {
+            server->accept(listener);
+            return;
+        }
+        listener->retry.expires_after(accept_retry_delay);
+        listener->retry.async_wait([listener](const asio::error_code& wait_error) {
+            if (!wait_error && listener->server != nullptr) listener->server->accept(listener);
+        });
+    });
+}
+
+void ModbusTcpServer::on_accepted(asio::ip::tcp::socket socket) {
+    asio::error_code error;
+    const auto peer_endpoint = socket.remote_endpoint(error);
+    if (error) return;  // reset before we got to it
+    const std::string peer = to_string(peer_endpoint);
+    const config::ModbusTcpConfig& config = *context_->config;
+    const config::IpAddress address = to_ip_address(peer_endpoint.address());
+    ServerStats& stats = context_->stats;
+    if (!config.client_allowed(address)) {
+        ++stats.refused_not_allowed;
+        socket.close(error);
+        log_refusal(fmt::format("Modbus TCP: refused {}: not in modbus_tcp.allow", peer));
+        return;
+    }
+    if (connections_.size() >= config.max_connections) {
+        ++stats.refused_max_connections;
+        socket.close(error);
+        log_refusal(fmt::format("Modbus TCP: refused {}: {} connections open (modbus_tcp.max_connections)", peer,
+                                connections_.size()));
+        return;
+    }
+    // Responses are small and gathered per connection: send them without Nagle's delay.
+    socket.set_option(asio::ip::tcp::no_delay(true), error);
+    const std::uint64_t id = next_connection_++;
+    auto connection = std::make_shared<Connection>(context_, std::move(socket), ClientRef{id, address}, peer);
+    connections_.emplace(id, connection);
+    ++stats.connections_accepted;
+    ++stats.connections_open;
+    log(context_->log, LogLevel::debug, "Modbus TCP: connection {} from {} ({} open)", id, peer, connections_.size());
+    connection->start();
+}
+
+void ModbusTcpServer::log_refusal(const std::string& message) {
+    const auto now = Clock::now();
+    if (last_refusal_log_ != Clock::time_point{} && now - last_refusal_log_ < refusal_log_interval) {
+        ++refusals_not_logged_;
+        return;
+    }
+    if (refusals_not_logged_ > 0) {
+        log(context_->log, LogLevel::warning, "{} ({} more refusal(s) since the last message)", message,
+            refusals_not_logged_);
+    } else {
+        log(context_->log, LogLevel::warning, "{}", message);
+    }
+    last_refusal_log_ = now;
+    refusals_not_logged_ = 0;
+}
+
+void ModbusTcpServer::apply(std::shared_ptr<const config::ModbusTcpConfig> config) {
+    context_->config = std::move(config);
+    const config::ModbusTcpConfig& now = *context_->config;
+    if (running() && now.listen != bound_) {
+        // Close first: the new set may reuse a port of the old one.
+        close_listeners();
+        try {
+            listeners_ = open_listeners(now);
+            bound_ = now.listen;
+        } catch (const ModbusTcpError& e) {
+            log(context_->log, LogLevel::error, "{}; keeping the previous listen addresses", e.what());
+            config::ModbusTcpConfig old = now;
+            old.listen = bound_;
+            try {
+                listeners_ = open_listeners(old);
+            } catch (const ModbusTcpError& again) {
+                log(context_->log, LogLevel::error, "{}; the Modbus TCP server accepts no connections", again.what());
+            }
+        }
+        start_accepting();
+    }
+    std::vector<std::shared_ptr<Connection>> refused;
+    for (auto& [id, connection] : connections_) {
+        if (!now.client_allowed(connection->client().address)) refused.push_back(connection);
+    }
+    for (auto& connection : refused) {
+        log(context_->log, LogLevel::info, "Modbus TCP: closing {}: no longer in modbus_tcp.allow", connection->peer());
+        connection->close(CloseReason::not_allowed);
+    }
+    for (auto& [id, connection] : connections_) connection->restart_idle_timer();
+}
+
+std::vector<asio::ip::tcp::endpoint> ModbusTcpServer::local_endpoints() const {
+    std::vector<asio::ip::tcp::endpoint> out;
+    for (const auto& listener : listeners_) {
+        asio::error_code error;
+        const auto endpoint = listener->acceptor.local_endpoint(error);
+        if (!error) out.push_back(endpoint);
+    }
+    return out;
+}
+
+std::uint16_t ModbusTcpServer::port() const {
+    const auto endpoints = local_endpoints();
+    return endpoints.empty() ? 0 : endpoints.front().port();
+}
+
+}  // namespace fieldbridge::northbound::modbus_tcp

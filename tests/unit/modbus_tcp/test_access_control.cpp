@@ -1,0 +1,115 @@
+// Request scope and rule decisions (pure), and the unit routing table.
+#include <doctest/doctest.h>
+
+#include "fake_targets.hpp"
+#include "northbound/modbus_tcp/access_control.hpp"
+#include "northbound/modbus_tcp/unit_router.hpp"
+#include "test_support.hpp"
+
+namespace fieldbridge::northbound::modbus_tcp {
+namespace {
+
+using config::RegisterRange;
+using protocol::Bytes;
+
+[[nodiscard]] config::IpAddress ip(const char* text) { return *config::parse_ip_address(text); }
+
+TEST_CASE("request_scope reads the address fields of FC01-06, 0F, 10 and both ranges of FC17") {
+    CHECK(request_scope(Bytes{0x01, 0x00, 0x10, 0x00, 0x08}) == RequestScope{0x01, RegisterRange{0x10, 0x17}, {}});
+    CHECK(request_scope(Bytes{0x02, 0x00, 0x00, 0x00, 0x01}) == RequestScope{0x02, RegisterRange{0, 0}, {}});
+    CHECK(request_scope(Bytes{0x03, 0x01, 0x00, 0x00, 0x7D}) == RequestScope{0x03, RegisterRange{0x100, 0x17C}, {}});
+    CHECK(request_scope(Bytes{0x04, 0x03, 0x00, 0x00, 0x02}) == RequestScope{0x04, RegisterRange{0x300, 0x301}, {}});
+    CHECK(request_scope(Bytes{0x05, 0x00, 0x07, 0xFF, 0x00}) == RequestScope{0x05, RegisterRange{7, 7}, {}});
+    CHECK(request_scope(Bytes{0x06, 0x01, 0x02, 0x00, 0x01}) == RequestScope{0x06, RegisterRange{0x102, 0x102}, {}});
+    CHECK(request_scope(Bytes{0x0F, 0x00, 0x13, 0x00, 0x0A, 0x02, 0xCD, 0x01}) ==
+          RequestScope{0x0F, RegisterRange{0x13, 0x1C}, {}});
+    CHECK(request_scope(Bytes{0x10, 0x00, 0x01, 0x00, 0x02, 0x04, 0x00, 0x0A, 0x01, 0x02}) ==
+          RequestScope{0x10, RegisterRange{1, 2}, {}});
+    // FC17 (V1.1b3 section 6.17 example): read 3 from 0x0003, write 3 at 0x000E.
+    CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00, 0x03, 0x06, 0, 0xFF, 0, 0xFF, 0, 0xFF}) ==
+          RequestScope{0x17, RegisterRange{3, 8}, RegisterRange{0x0E, 0x10}});
+}
+
+TEST_CASE("request_scope: no range without address fields, and a malformed quantity never shrinks the range") {
+    CHECK(request_scope(Bytes{0x07}) == RequestScope{0x07, {}, {}});
+    CHECK(request_scope(Bytes{0x2B, 0x0E, 0x01, 0x00}) == RequestScope{0x2B, {}, {}});
+    CHECK(request_scope(Bytes{0x03, 0x00, 0x10, 0x00}) == RequestScope{0x03, {}, {}});  // truncated
+    CHECK(request_scope(Bytes{0x06, 0x00}) == RequestScope{0x06, {}, {}});
+    CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00}) == RequestScope{0x17, {}, {}});
+    CHECK(request_scope(Bytes{}) == RequestScope{});
+    // Quantity 0 still names the addressed register.
+    CHECK(request_scope(Bytes{0x03, 0x00, 0x64, 0x00, 0x00}) == RequestScope{0x03, RegisterRange{100, 100}, {}});
+    // Past 0xFFFF: ends at 0xFFFF.
+    CHECK(request_scope(Bytes{0x10, 0xFF, 0xFE, 0x00, 0x7B}) == RequestScope{0x10, RegisterRange{0xFFFE, 0xFFFF}, {}});
+}
+
+TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges allowed") {
+    config::ModbusTcpConfig config;
+    CHECK(request_allowed(config, ip("10.0.0.1"), 1, request_scope(Bytes{0x06, 0, 1, 0, 1})));  // no rules
+
+    config::AccessRule plc_writes;  // the PLC may write registers 0x100-0x1FF of unit 1
+    plc_writes.clients = {test::cidr("10.0.0.5")};
+    plc_writes.units = {1};
+    plc_writes.functions = {0x06, 0x10, 0x17};
+    plc_writes.registers = RegisterRange{0x100, 0x1FF};
+    plc_writes.action = config::RuleAction::allow;
+    config::AccessRule no_other_writes;
+    no_other_writes.functions = {0x05, 0x06, 0x0F, 0x10, 0x17};
+    no_other_writes.action = config::RuleAction::deny;
+    config.rules = {plc_writes, no_other_writes};
+
+    const auto plc = ip("10.0.0.5");
+    const auto scada = ip("10.0.0.9");
+    CHECK(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));
+    CHECK_FALSE(request_allowed(config, plc, 2, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));   // other unit
+    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x00, 0x10, 0, 1})));   // outside
+    CHECK_FALSE(request_allowed(config, scada, 1, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));  // not the PLC
+    CHECK(request_allowed(config, scada, 1, request_scope(Bytes{0x03, 0x01, 0x10, 0, 1})));        // reads pass
+    // Allow needs containment: a write reaching past 0x1FF is denied.
+    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x10, 0x01, 0xFF, 0, 2, 4, 0, 1, 0, 2})));
+    // FC17 of the PLC: the read range outside its allow rule falls to the deny rule.
+    const Bytes rw_inside{0x17, 0x01, 0x00, 0x00, 0x01, 0x01, 0x10, 0x00, 0x01, 0x02, 0x00, 0x01};
+    const Bytes rw_read_outside{0x17, 0x00, 0x00, 0x00, 0x01, 0x01, 0x10, 0x00, 0x01, 0x02, 0x00, 0x01};
+    CHECK(request_allowed(config, plc, 1, request_scope(rw_inside)));
+    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(rw_read_outside)));
+    // A truncated write has no range: the allow rule (with a range) cannot match it.
+    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x01})));
+}
+
+TEST_CASE("a deny rule matches any overlap with its register range") {
+    config::ModbusTcpConfig config;
+    config::AccessRule protect;
+    protect.registers = RegisterRange{0x0200, 0x0203};
+    protect.action = config::RuleAction::deny;
+    config.rules = {protect};
+    const auto client = ip("192.168.1.2");
+    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x20})));
+    CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x10})));  // ends at 0x1FF
+    CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x07})));  // no registers: no match
+}
+
+TEST_CASE("UnitRouter: set, replace, remove, distinct targets") {
+    asio::io_context io;
+    test::ImmediateTarget a(io);
+    test::ImmediateTarget b(io);
+    UnitRouter router;
+    CHECK(router.find(1) == nullptr);
+    router.set(1, a);
+    router.set(2, a);
+    router.set(200, b);
+    CHECK(router.find(1) == &a);
+    CHECK(router.find(200) == &b);
+    CHECK(router.size() == 3);
+    CHECK(router.targets() == std::vector<UnitTarget*>{&a, &b});
+    router.set(2, b);
+    CHECK(router.find(2) == &b);
+    router.remove(1);
+    CHECK(router.find(1) == nullptr);
+    CHECK(router.targets() == std::vector<UnitTarget*>{&b});
+    router.clear();
+    CHECK(router.size() == 0);
+    CHECK(router.targets().empty());
+}
+
+}  // namespace
+}  // namespace fieldbridge::northbound::modbus_tcp
