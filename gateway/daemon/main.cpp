@@ -14,6 +14,8 @@
 #include "daemon/check_config.hpp"
 #include "daemon/command_line.hpp"
 #include "daemon/daemon.hpp"
+#include "daemon/engine_component.hpp"
+#include "daemon/modbus_tcp_component.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_service_manager.hpp"
@@ -58,8 +60,13 @@ using namespace fieldbridge;
     options.config_file = command.config_file;
     options.log_level_override = command.log_level;
     daemon::Daemon gateway(std::move(options), std::move(initial), load, manager, logger);
-    // Components (line engine, Modbus TCP server, MQTT bridge) register here with
-    // gateway.add_component() and gateway.add_status() as they are added.
+    // Components start in this order and stop in the reverse one.
+    daemon::EngineComponent engine(gateway.context(), logger);
+    gateway.add_component(engine);
+    gateway.add_status([&engine] { return engine.status(); });
+    daemon::ModbusTcpComponent modbus_tcp(gateway.context(), logger, engine);
+    gateway.add_component(modbus_tcp);
+    gateway.add_status([&modbus_tcp] { return modbus_tcp.status(); });
     return gateway.run();
 }
 

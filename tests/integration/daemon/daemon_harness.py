@@ -24,12 +24,21 @@ TIMEOUT = 15.0
 _SERVICE_VARIABLES = ("NOTIFY_SOCKET", "WATCHDOG_USEC", "WATCHDOG_PID", "JOURNAL_STREAM", "LISTEN_FDS",
                       "LISTEN_PID", "LISTEN_FDNAMES", "INVOCATION_ID")
 
+def _free_port():
+    """A loopback port nobody listens on now: daemon tests run in parallel."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+_PORT = {"port": _free_port()}
+
 CONFIG_ONE_LINE = """\
 gateway:
   id: itest
   log_level: info
 modbus_tcp:
-  listen: ["127.0.0.1:15020"]
+  listen: ["127.0.0.1:%(port)d"]
 lines:
   - name: line-a
     port: /dev/fieldbridge-itest-absent-a
@@ -51,7 +60,7 @@ gateway:
   id: itest
   colour: blue
 modbus_tcp:
-  listen: ["127.0.0.1:15020"]
+  listen: ["127.0.0.1:%(port)d"]
 lines:
   - name: line-a
     port: /dev/fieldbridge-itest-absent-a
@@ -59,6 +68,7 @@ lines:
     devices:
       - {name: gripper-1, type: hiwin-xeg, address: 1, unit_id: 1}
 """
+CONFIG_ONE_LINE, CONFIG_TWO_LINES, CONFIG_BROKEN = (c % _PORT for c in (CONFIG_ONE_LINE, CONFIG_TWO_LINES, CONFIG_BROKEN))
 
 
 def parse_arguments():

@@ -31,7 +31,7 @@ class Logging(h.DaemonTestCase, unittest.TestCase):
         self.assertTrue(lines)
         for line in lines:
             self.assertRegex(line, JOURNAL)
-        self.assertIn("<6>ready: 1 line, 2 devices", lines)
+        self.assertTrue(any(line.startswith("<6>ready: 1 line, 2 devices, lines 0/1 up, devices 0/2 online, Modbus TCP: ") for line in lines), lines)
         self.assertTrue(any(line.startswith("<7>") for line in lines), lines)  # debug, from --log-level
 
     def test_journal_stream_of_another_file_means_human_format(self):
@@ -44,7 +44,7 @@ class Logging(h.DaemonTestCase, unittest.TestCase):
         lines = self.run_until_ready_and_stop(lambda identity: {})
         for line in lines:
             self.assertRegex(line, HUMAN)
-        self.assertTrue(any("[info] ready: 1 line, 2 devices" in line for line in lines), lines)
+        self.assertTrue(any("[info] ready: 1 line, 2 devices, lines 0/1 up, devices 0/2 online" in line for line in lines), lines)
 
     def test_config_errors_are_logged_at_error_priority(self):
         path = self.config(h.CONFIG_BROKEN)

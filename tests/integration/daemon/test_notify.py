@@ -20,7 +20,7 @@ class Notify(h.DaemonTestCase, unittest.TestCase):
     def test_ready_status_and_stop_on_sigterm(self):
         notify, gateway = self.start_notified()
         ready = notify.wait_for_prefix("READY=1")
-        self.assertEqual(ready, "READY=1\nSTATUS=1 line, 2 devices")
+        self.assertTrue(ready.startswith("READY=1\nSTATUS=1 line, 2 devices, lines 0/1 up, devices 0/2 online, Modbus TCP: "), ready)
         self.assertTrue(gateway.running())
         gateway.send(signal.SIGTERM)
         stopping = notify.wait_for_prefix("STOPPING=1")

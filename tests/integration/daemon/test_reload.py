@@ -14,7 +14,8 @@ class Reload(h.DaemonTestCase, unittest.TestCase):
         notify = self.notify_socket()
         path = self.config(h.CONFIG_ONE_LINE)
         gateway = self.start(["--config", path], env=h.clean_environment({"NOTIFY_SOCKET": notify.path}))
-        self.assertEqual(notify.wait_for_prefix("READY=1"), "READY=1\nSTATUS=1 line, 2 devices")
+        ready = notify.wait_for_prefix("READY=1")
+        self.assertTrue(ready.startswith("READY=1\nSTATUS=1 line, 2 devices, lines 0/1 up, devices 0/2 online" + ", Modbus TCP: "), ready)
 
         # A broken file: RELOADING=1, every diagnostic logged, READY=1 again with
         # the old configuration, and the process keeps running.
@@ -22,8 +23,8 @@ class Reload(h.DaemonTestCase, unittest.TestCase):
         gateway.send(signal.SIGHUP)
         reloading = notify.wait_for_prefix("RELOADING=1")
         self.assertRegex(reloading, r"^RELOADING=1\nMONOTONIC_USEC=\d+$")
-        self.assertEqual(notify.wait_for_prefix("READY=1"),
-                         "READY=1\nSTATUS=last reload rejected (see the log), 1 line, 2 devices")
+        ready = notify.wait_for_prefix("READY=1")
+        self.assertTrue(ready.startswith("READY=1\nSTATUS=last reload rejected (see the log), 1 line, 2 devices, lines 0/1 up, devices 0/2 online" + ", Modbus TCP: "), ready)
         gateway.wait_for_log("%s:3:3: gateway.colour: " % path)
         gateway.wait_for_log("%s:9:11: lines[0].baud: " % path)
         gateway.wait_for_log("configuration reload rejected: 2 problems in %s" % path)
@@ -33,7 +34,8 @@ class Reload(h.DaemonTestCase, unittest.TestCase):
         h.write_file(self.tmp, os.path.basename(path), h.CONFIG_TWO_LINES)
         gateway.send(signal.SIGHUP)
         notify.wait_for_prefix("RELOADING=1")
-        self.assertEqual(notify.wait_for_prefix("READY=1"), "READY=1\nSTATUS=2 lines, 3 devices")
+        ready = notify.wait_for_prefix("READY=1")
+        self.assertTrue(ready.startswith("READY=1\nSTATUS=2 lines, 3 devices, lines 0/2 up, devices 0/3 online" + ", Modbus TCP: "), ready)
         gateway.wait_for_log("configuration reloaded from %s (2 lines, 3 devices, MQTT disabled)" % path)
 
         gateway.send(signal.SIGTERM)

@@ -1,0 +1,70 @@
+#include "daemon/engine_component.hpp"
+
+namespace fieldbridge::daemon {
+
+engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger) {
+    engine::LogSink sink;
+    // The sink's threshold follows the logger's level at each call (a reload may
+    // change it), so it lets everything through and the logger decides.
+    sink.min_level = engine::LogLevel::debug;
+    sink.write = [logger = std::move(logger)](engine::LogLevel level, std::string_view message) {
+        switch (level) {
+            case engine::LogLevel::debug: logger->debug("{}", message); break;
+            case engine::LogLevel::info: logger->info("{}", message); break;
+            case engine::LogLevel::warning: logger->warn("{}", message); break;
+            case engine::LogLevel::error: logger->error("{}", message); break;
+        }
+    };
+    return sink;
+}
+
+EngineComponent::EngineComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger,
+                                 engine::PortFactory ports)
+    : io_(io), logger_(std::move(logger)), ports_(std::move(ports)) {}
+
+EngineComponent::~EngineComponent() {
+    if (engine_) engine_->stop();
+}
+
+void EngineComponent::notify(engine::Engine* engine) {
+    for (const auto& listener : listeners_) listener(engine);
+}
+
+void EngineComponent::build(const config::Config& config) {
+    engine_ = std::make_unique<engine::Engine>(io_, config, engine_log_sink(logger_), ports_);
+    engine_->start();
+    logger_->info("line engine: {} line(s), {} device(s); {}", engine_->lines().size(), engine_->devices().size(),
+                  engine_->status());
+    notify(engine_.get());
+}
+
+void EngineComponent::tear_down() {
+    if (!engine_) return;
+    notify(nullptr);
+    engine_->stop();
+    engine_.reset();
+}
+
+void EngineComponent::start(StartContext& context) {
+    config_ = context.config();
+    // READY does not wait for the ports: a missing adapter is retried with back-off
+    // and reported, and the rest of the gateway (TCP, MQTT) must come up regardless.
+    build(*config_);
+}
+
+void EngineComponent::stop(StopContext& /*context*/) { tear_down(); }
+
+void EngineComponent::apply(std::shared_ptr<const config::Config> config) {
+    if (config_ && config_->lines == config->lines) {
+        config_ = std::move(config);
+        return;
+    }
+    logger_->info("line engine: lines or devices changed; reopening the lines (queued requests are cancelled)");
+    tear_down();
+    config_ = std::move(config);
+    build(*config_);
+}
+
+std::string EngineComponent::status() const { return engine_ ? engine_->status() : std::string("engine stopped"); }
+
+}  // namespace fieldbridge::daemon

@@ -1,0 +1,57 @@
+#pragma once
+/// @file engine_component.hpp
+/// The line engine as a daemon component: built from the configuration at start,
+/// rebuilt on a reload that changes lines or devices (their ports are closed and
+/// reopened, queued requests complete `cancelled`), left alone otherwise.
+#include <asio/io_context.hpp>
+#include <memory>
+#include <spdlog/logger.h>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "daemon/component.hpp"
+#include "engine/engine.hpp"
+
+namespace fieldbridge::daemon {
+
+/// The engine's log sink: messages go to @p logger at the matching level, and are
+/// built only when the logger would print them.
+[[nodiscard]] engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger);
+
+class EngineComponent final : public Component {
+public:
+    EngineComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger,
+                    engine::PortFactory ports = engine::posix_port_factory());
+    ~EngineComponent() override;
+
+    [[nodiscard]] std::string name() const override { return "line engine"; }
+    void start(StartContext& context) override;
+    void stop(StopContext& context) override;
+    void apply(std::shared_ptr<const config::Config> config) override;
+
+    /// Nullptr before start() and after stop().
+    [[nodiscard]] engine::Engine* engine() const noexcept { return engine_.get(); }
+
+    /// Called with nullptr just before the engine is destroyed (stop, or a reload that
+    /// rebuilds it) and with the new engine once it runs: whoever holds pointers into
+    /// the engine (routes, MQTT sources) drops and re-takes them here.
+    using ChangeListener = std::function<void(engine::Engine*)>;
+    void on_change(ChangeListener listener) { listeners_.push_back(std::move(listener)); }
+    /// For STATUS=.
+    [[nodiscard]] std::string status() const;
+
+private:
+    void build(const config::Config& config);
+    void tear_down();
+    void notify(engine::Engine* engine);
+
+    asio::io_context& io_;
+    std::shared_ptr<spdlog::logger> logger_;
+    engine::PortFactory ports_;
+    std::shared_ptr<const config::Config> config_;
+    std::unique_ptr<engine::Engine> engine_;
+    std::vector<ChangeListener> listeners_;
+};
+
+}  // namespace fieldbridge::daemon

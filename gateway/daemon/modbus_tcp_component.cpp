@@ -1,0 +1,103 @@
+#include "daemon/modbus_tcp_component.hpp"
+
+namespace fieldbridge::daemon {
+
+namespace {
+
+std::shared_ptr<const config::ModbusTcpConfig> tcp_config(const std::shared_ptr<const config::Config>& config) {
+    // Aliasing constructor: the server's view keeps the whole configuration alive.
+    return {config, &config->modbus_tcp};
+}
+
+}  // namespace
+
+ModbusTcpComponent::ModbusTcpComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger,
+                                       EngineComponent& engine)
+    : io_(io), logger_(std::move(logger)), engine_(engine) {
+    engine_.on_change([this](engine::Engine* current) {
+        if (server_) rebuild_routes(current);
+    });
+}
+
+ModbusTcpComponent::~ModbusTcpComponent() {
+    if (server_) server_->stop();
+    stop_upstreams();
+}
+
+void ModbusTcpComponent::build_upstreams() {
+    for (const auto& upstream : config_->upstreams) {
+        upstreams_.push_back(
+            std::make_unique<northbound::upstream::UpstreamTarget>(io_, upstream, engine_log_sink(logger_)));
+        upstreams_.back()->start();
+    }
+}
+
+void ModbusTcpComponent::stop_upstreams() {
+    for (auto& upstream : upstreams_) upstream->stop();
+    upstreams_.clear();
+}
+
+void ModbusTcpComponent::rebuild_routes(engine::Engine* engine) {
+    auto& routes = server_->routes();
+    routes.clear();
+    serial_targets_.clear();
+    if (engine != nullptr) {
+        for (const auto& line : engine->lines()) {
+            for (const auto& device : engine->devices()) {
+                if (device.line != line.worker->config().name) continue;
+                serial_targets_.push_back(
+                    std::make_unique<northbound::SerialDeviceTarget>(io_, *device.agent, *line.worker));
+                routes.set(device.unit_id, *serial_targets_.back());
+            }
+            if (line.broadcast_unit) {
+                serial_targets_.push_back(std::make_unique<northbound::LineBroadcastTarget>(
+                    io_, *line.worker, line.broadcast_addresses, line.broadcast_ttl));
+                routes.set(*line.broadcast_unit, *serial_targets_.back());
+            }
+        }
+    }
+    for (std::size_t u = 0; u < upstreams_.size(); ++u) {
+        for (const auto& unit : config_->upstreams.at(u).units) routes.set(unit.unit_id, *upstreams_[u]);
+    }
+}
+
+void ModbusTcpComponent::start(StartContext& context) {
+    config_ = context.config();
+    server_ = std::make_unique<northbound::modbus_tcp::ModbusTcpServer>(io_, tcp_config(config_),
+                                                                         engine_log_sink(logger_));
+    build_upstreams();
+    rebuild_routes(engine_.engine());
+    // Binding is synchronous: when start() returns the listeners accept, so READY
+    // may go out (a bind failure throws with what to do and the gateway stops).
+    server_->start();
+    for (const auto& endpoint : server_->local_endpoints()) {
+        logger_->info("Modbus TCP: listening on {}:{}", endpoint.address().to_string(), endpoint.port());
+    }
+}
+
+void ModbusTcpComponent::stop(StopContext& /*context*/) {
+    if (server_) {
+        server_->stop();
+        server_->routes().clear();
+    }
+    serial_targets_.clear();
+    stop_upstreams();
+    server_.reset();
+}
+
+void ModbusTcpComponent::apply(std::shared_ptr<const config::Config> config) {
+    const bool upstreams_changed = !config_ || config_->upstreams != config->upstreams;
+    config_ = std::move(config);
+    if (!server_) return;
+    server_->apply(tcp_config(config_));
+    if (upstreams_changed) {
+        server_->routes().clear();
+        stop_upstreams();
+        build_upstreams();
+    }
+    rebuild_routes(engine_.engine());
+}
+
+std::string ModbusTcpComponent::status() const { return server_ ? server_->status() : std::string("Modbus TCP off"); }
+
+}  // namespace fieldbridge::daemon

@@ -1,0 +1,57 @@
+#pragma once
+/// @file modbus_tcp_component.hpp
+/// The Modbus TCP side as a daemon component: the server, the upstream (R6)
+/// pass-through targets, and the routing table from unit IDs to targets (serial
+/// devices of the engine, lines' broadcast units, upstream units). Routes follow the
+/// engine: they are dropped before it is rebuilt and set again from the new one.
+#include <asio/io_context.hpp>
+#include <memory>
+#include <spdlog/logger.h>
+#include <string>
+#include <vector>
+
+#include "daemon/component.hpp"
+#include "daemon/engine_component.hpp"
+#include "northbound/modbus_tcp/server.hpp"
+#include "northbound/targets/line_broadcast_target.hpp"
+#include "northbound/targets/serial_device_target.hpp"
+#include "northbound/upstream/upstream_target.hpp"
+
+namespace fieldbridge::daemon {
+
+class ModbusTcpComponent final : public Component {
+public:
+    /// @p engine must be registered before this component (it starts first).
+    ModbusTcpComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger, EngineComponent& engine);
+    ~ModbusTcpComponent() override;
+
+    [[nodiscard]] std::string name() const override { return "Modbus TCP server"; }
+    void start(StartContext& context) override;
+    void stop(StopContext& context) override;
+    void apply(std::shared_ptr<const config::Config> config) override;
+
+    /// The upstream targets, one per configured upstream (for the MQTT R6 sources).
+    [[nodiscard]] const std::vector<std::unique_ptr<northbound::upstream::UpstreamTarget>>& upstreams() const noexcept {
+        return upstreams_;
+    }
+    /// Nullptr before start() and after stop().
+    [[nodiscard]] const northbound::modbus_tcp::ModbusTcpServer* server() const noexcept { return server_.get(); }
+    /// For STATUS=.
+    [[nodiscard]] std::string status() const;
+
+private:
+    void build_upstreams();
+    void stop_upstreams();
+    /// Serial and broadcast targets from @p engine (nullptr: none), then every route.
+    void rebuild_routes(engine::Engine* engine);
+
+    asio::io_context& io_;
+    std::shared_ptr<spdlog::logger> logger_;
+    EngineComponent& engine_;
+    std::shared_ptr<const config::Config> config_;
+    std::unique_ptr<northbound::modbus_tcp::ModbusTcpServer> server_;
+    std::vector<std::unique_ptr<northbound::upstream::UpstreamTarget>> upstreams_;
+    std::vector<std::unique_ptr<northbound::UnitTarget>> serial_targets_;
+};
+
+}  // namespace fieldbridge::daemon

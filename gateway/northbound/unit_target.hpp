@@ -1,0 +1,41 @@
+#pragma once
+/// @file unit_target.hpp
+/// What a Modbus TCP unit ID leads to (spec §4): a serial device (its DeviceAgent), a
+/// line's broadcast unit, or a unit of an upstream Modbus TCP server (Huacheng R6
+/// pass-through). The server decodes MBAP, applies access control, and hands the PDU
+/// to the target of the unit; the target answers with a response PDU (normal or
+/// exception) through the handler, exactly once, on the loop thread, never from
+/// inside handle().
+#include <cstdint>
+#include <functional>
+
+#include "config/net_address.hpp"
+#include "protocol/bytes.hpp"
+
+namespace fieldbridge::northbound {
+
+/// Who sent a request: stateful upstream sequences (R6 counter indirection) are kept
+/// per client connection.
+struct ClientRef {
+    std::uint64_t connection = 0;  ///< unique for the process lifetime
+    config::IpAddress address;
+};
+
+/// Receives the response PDU (function code first; an exception is fc | 0x80, code).
+using PduHandler = std::function<void(protocol::Bytes response_pdu)>;
+
+class UnitTarget {
+public:
+    UnitTarget() = default;
+    virtual ~UnitTarget() = default;
+    UnitTarget(const UnitTarget&) = delete;
+    UnitTarget& operator=(const UnitTarget&) = delete;
+
+    /// @p request_pdu is a complete PDU as received (function code first).
+    virtual void handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
+                        PduHandler done) = 0;
+    /// The client's connection closed: drop its state, answer nothing more to it.
+    virtual void client_closed(std::uint64_t /*connection*/) {}
+};
+
+}  // namespace fieldbridge::northbound
