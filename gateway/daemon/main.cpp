@@ -1,6 +1,7 @@
 // fieldbridge: the gateway's entry point. Parses the command line, creates the
 // logger, loads the configuration, and hands everything to the Daemon.
 
+#include <nlohmann/json.hpp>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <unistd.h>
 
@@ -16,6 +17,8 @@
 #include "daemon/daemon.hpp"
 #include "daemon/engine_component.hpp"
 #include "daemon/modbus_tcp_component.hpp"
+#include "northbound/mqtt/mqtt_component.hpp"
+#include "northbound/mqtt/r6_source.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_service_manager.hpp"
@@ -67,6 +70,40 @@ using namespace fieldbridge;
     daemon::ModbusTcpComponent modbus_tcp(gateway.context(), logger, engine);
     gateway.add_component(modbus_tcp);
     gateway.add_status([&modbus_tcp] { return modbus_tcp.status(); });
+    // MQTT last among the components: stopped first, so `offline` goes out while the
+    // lines still run.
+    northbound::mqtt::MqttComponent mqtt(gateway.context(), logger, [&engine] { return engine.engine(); });
+    std::vector<std::shared_ptr<northbound::mqtt::DeviceSource>> r6_sources;
+    mqtt.add_sources([&] {
+        northbound::mqtt::detach_r6_sources(r6_sources);
+        r6_sources.clear();
+        for (const auto& upstream : modbus_tcp.upstreams()) {
+            for (auto& source : northbound::mqtt::make_r6_sources(gateway.context(), *upstream)) {
+                r6_sources.push_back(std::move(source));
+            }
+        }
+        return r6_sources;
+    });
+    modbus_tcp.on_upstreams_closing([&r6_sources] {
+        northbound::mqtt::detach_r6_sources(r6_sources);
+        r6_sources.clear();
+    });
+    mqtt.add_diag([&modbus_tcp] {
+        nlohmann::json diag = nlohmann::json::object();
+        if (const auto* server = modbus_tcp.server()) {
+            const auto& stats = server->stats();
+            diag["modbus_tcp"] = {{"clients", stats.connections_open},
+                                  {"accepted", stats.connections_accepted},
+                                  {"refused", stats.refused_max_connections + stats.refused_not_allowed},
+                                  {"requests", stats.requests},
+                                  {"exceptions", stats.exceptions_total()},
+                                  {"denied", stats.denied},
+                                  {"closed_malformed", stats.closed_malformed}};
+        }
+        return diag;
+    });
+    gateway.add_component(mqtt);
+    gateway.add_status([&mqtt] { return mqtt.status(); });
     return gateway.run();
 }
 

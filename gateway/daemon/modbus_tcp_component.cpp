@@ -33,6 +33,9 @@ void ModbusTcpComponent::build_upstreams() {
 }
 
 void ModbusTcpComponent::stop_upstreams() {
+    if (!upstreams_.empty()) {
+        for (const auto& listener : upstreams_closing_) listener();
+    }
     for (auto& upstream : upstreams_) upstream->stop();
     upstreams_.clear();
 }
@@ -69,10 +72,7 @@ void ModbusTcpComponent::start(StartContext& context) {
     rebuild_routes(engine_.engine());
     // Binding is synchronous: when start() returns the listeners accept, so READY
     // may go out (a bind failure throws with what to do and the gateway stops).
-    server_->start();
-    for (const auto& endpoint : server_->local_endpoints()) {
-        logger_->info("Modbus TCP: listening on {}:{}", endpoint.address().to_string(), endpoint.port());
-    }
+    server_->start();  // logs each listener
 }
 
 void ModbusTcpComponent::stop(StopContext& /*context*/) {

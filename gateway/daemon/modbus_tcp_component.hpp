@@ -5,6 +5,7 @@
 /// devices of the engine, lines' broadcast units, upstream units). Routes follow the
 /// engine: they are dropped before it is rebuilt and set again from the new one.
 #include <asio/io_context.hpp>
+#include <functional>
 #include <memory>
 #include <spdlog/logger.h>
 #include <string>
@@ -38,6 +39,9 @@ public:
     [[nodiscard]] const northbound::modbus_tcp::ModbusTcpServer* server() const noexcept { return server_.get(); }
     /// For STATUS=.
     [[nodiscard]] std::string status() const;
+    /// Called just before the upstream targets are destroyed (stop, or a reload that
+    /// changes the upstreams): whoever holds them (MQTT R6 sources) lets go.
+    void on_upstreams_closing(std::function<void()> listener) { upstreams_closing_.push_back(std::move(listener)); }
 
 private:
     void build_upstreams();
@@ -52,6 +56,7 @@ private:
     std::unique_ptr<northbound::modbus_tcp::ModbusTcpServer> server_;
     std::vector<std::unique_ptr<northbound::upstream::UpstreamTarget>> upstreams_;
     std::vector<std::unique_ptr<northbound::UnitTarget>> serial_targets_;
+    std::vector<std::function<void()>> upstreams_closing_;
 };
 
 }  // namespace fieldbridge::daemon

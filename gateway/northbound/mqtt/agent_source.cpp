@@ -1,0 +1,125 @@
+#include "northbound/mqtt/agent_source.hpp"
+
+#include <algorithm>
+
+#include <asio/post.hpp>
+
+namespace fieldbridge::northbound::mqtt {
+
+std::string_view to_string(CommandSet set) noexcept {
+    switch (set) {
+        case CommandSet::xeg: return "xeg";
+        case CommandSet::excd: return "excd";
+        case CommandSet::wtec: return "wtec";
+        case CommandSet::r6: return "r6";
+        case CommandSet::generic: return "generic";
+    }
+    return "generic";
+}
+
+CommandSet command_set_of(engine::DeviceType type) noexcept {
+    switch (type) {
+        case engine::DeviceType::hiwin_xeg: return CommandSet::xeg;
+        case engine::DeviceType::excd203mb: return CommandSet::excd;
+        case engine::DeviceType::wtec_rtu:
+        case engine::DeviceType::wtec_ascii: return CommandSet::wtec;
+        case engine::DeviceType::modbus: return CommandSet::generic;
+    }
+    return CommandSet::generic;
+}
+
+SourceState image_state(const engine::DeviceProfile& profile, const engine::RegisterImage& image, bool online) {
+    SourceState s;
+    s.online = online && !image.offline();
+    bool any = false;
+    bool stale = false;
+    for (std::size_t t = 0; t < engine::table_count; ++t) {
+        const auto table = static_cast<engine::Table>(t);
+        for (const engine::RegisterEntry& e : image.entries(table)) {
+            if (e.quality == engine::Quality::unknown) continue;
+            any = true;
+            stale = stale || e.quality != engine::Quality::good;
+            if (!s.updated || e.updated > *s.updated) s.updated = e.updated;
+            s.raw.push_back(RawRegister{table, e.address, e.value});
+        }
+    }
+    if (!s.online) {
+        s.quality = engine::Quality::offline;
+    } else if (!any) {
+        s.quality = engine::Quality::unknown;
+    } else {
+        s.quality = stale ? engine::Quality::stale : engine::Quality::good;
+    }
+    s.decoded = profile.decode_state(image);
+    return s;
+}
+
+AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool commands_enabled)
+    : io_(io),
+      agent_(&agent),
+      name_(agent.config().name),
+      type_(agent.profile().type()),
+      commands_enabled_(commands_enabled),
+      listener_(std::make_shared<SourceListener>()) {
+    const std::weak_ptr<SourceListener> weak = listener_;
+    subscription_ = agent.image().subscribe([weak](const engine::ImageChange&) {
+        if (auto l = weak.lock(); l && l->changed) l->changed();
+    });
+    agent.set_notice_callback([weak](const engine::DeviceNotice& notice) {
+        if (auto l = weak.lock(); l && l->notice) l->notice(notice);
+    });
+}
+
+AgentSource::~AgentSource() {
+    if (agent_ != nullptr) {
+        (void)agent_->image().unsubscribe(subscription_);
+        agent_->set_notice_callback({});
+    }
+}
+
+void AgentSource::detach() noexcept {
+    agent_ = nullptr;
+    *listener_ = SourceListener{};
+}
+
+std::string_view AgentSource::type() const { return engine::to_string(type_); }
+
+CommandSet AgentSource::command_set() const { return command_set_of(type_); }
+
+SourceState AgentSource::state() const {
+    if (agent_ == nullptr) {
+        SourceState s;
+        s.quality = engine::Quality::offline;
+        return s;
+    }
+    return image_state(agent_->profile(), agent_->image(), agent_->online());
+}
+
+std::vector<engine::Alarm> AgentSource::alarms() const {
+    if (agent_ == nullptr) return {};
+    return agent_->profile().alarms(agent_->image());
+}
+
+void AgentSource::set_listener(SourceListener listener) {
+    if (agent_ == nullptr) return;
+    *listener_ = std::move(listener);
+}
+
+std::optional<protocol::ExceptionCode> AgentSource::validate(const protocol::Request& request) const {
+    if (agent_ == nullptr) return protocol::ExceptionCode::gateway_path_unavailable;
+    return agent_->profile().validate(request, agent_->image());
+}
+
+void AgentSource::execute(const protocol::Request& request, engine::ResponseHandler done) {
+    if (agent_ == nullptr) {
+        const std::uint8_t function = protocol::function_of(request);
+        asio::post(io_, [done = std::move(done), function] {
+            done(protocol::Response{
+                protocol::ExceptionResponse{function, protocol::ExceptionCode::gateway_path_unavailable}});
+        });
+        return;
+    }
+    agent_->request(request, std::move(done));
+}
+
+}  // namespace fieldbridge::northbound::mqtt

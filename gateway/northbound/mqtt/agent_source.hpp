@@ -1,0 +1,54 @@
+#pragma once
+/// @file agent_source.hpp
+/// A serial device (its DeviceAgent) as a DeviceSource of the MQTT bridge: state and
+/// alarms from the agent's profile over its register image, change notifications
+/// from the image's subscription and the agent's notices, commands through
+/// DeviceAgent::request (the same validation, command lane and deadline as Modbus
+/// TCP writes).
+///
+/// The engine owns the agent and may be rebuilt (reload): detach() before that
+/// forgets the agent without touching it; a detached source reports the device
+/// offline and answers commands 0x0A. Loop thread only.
+#include <memory>
+#include <string>
+
+#include "engine/device_agent.hpp"
+#include "northbound/mqtt/device_source.hpp"
+
+namespace fieldbridge::northbound::mqtt {
+
+class AgentSource final : public DeviceSource {
+public:
+    AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool commands_enabled);
+    ~AgentSource() override;
+
+    [[nodiscard]] const std::string& name() const override { return name_; }
+    [[nodiscard]] std::string_view type() const override;
+    [[nodiscard]] CommandSet command_set() const override;
+    [[nodiscard]] bool commands_enabled() const override { return commands_enabled_; }
+    [[nodiscard]] SourceState state() const override;
+    [[nodiscard]] std::vector<engine::Alarm> alarms() const override;
+    void set_listener(SourceListener listener) override;
+    [[nodiscard]] std::optional<protocol::ExceptionCode> validate(const protocol::Request& request) const override;
+    void execute(const protocol::Request& request, engine::ResponseHandler done) override;
+
+    /// The agent is about to be destroyed (or already is): never touch it again.
+    void detach() noexcept;
+
+private:
+    asio::io_context& io_;
+    engine::DeviceAgent* agent_;
+    std::string name_;
+    engine::DeviceType type_;
+    bool commands_enabled_;
+    engine::RegisterImage::SubscriptionId subscription_ = 0;
+    // Shared with the image's listener and the notice callback, which the engine
+    // may call after this source is gone (it holds them, not the other way round).
+    std::shared_ptr<SourceListener> listener_;
+};
+
+/// The state of any image, as the bridge sees it (also for tests).
+[[nodiscard]] SourceState image_state(const engine::DeviceProfile& profile, const engine::RegisterImage& image,
+                                      bool online);
+
+}  // namespace fieldbridge::northbound::mqtt

@@ -1,0 +1,56 @@
+#pragma once
+/// @file command_parser.hpp
+/// `<prefix>/<device>/cmd` payloads -> Modbus requests (docs/mqtt.md, "Commands").
+/// A command is a JSON object with an `id` (string or number, echoed in the result),
+/// an `op` of the device's command set, and the op's fields; nothing else. The
+/// parser checks JSON types and the ranges it can know without the device (16-bit
+/// registers, signed 32-bit positions, enumerations); the device's profile checks the
+/// rest (model-dependent strokes, protected registers) before anything is sent.
+/// Pure.
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "northbound/mqtt/device_source.hpp"
+#include "protocol/modbus_pdu.hpp"
+
+namespace fieldbridge::northbound::mqtt {
+
+/// A command ready to execute: its requests go out in order, each after the previous
+/// one was acknowledged.
+struct ParsedCommand {
+    nlohmann::json id;
+    std::string op;
+    std::vector<protocol::Request> requests;
+};
+
+/// Why a command was refused before anything was sent.
+enum class CommandErrorKind : std::uint8_t {
+    bad_json,       ///< not JSON, or not an object
+    missing_id,     ///< no `id`, or not a string / number
+    unknown_op,     ///< no `op`, or not one of the device's command set
+    missing_field,
+    invalid_field,  ///< wrong JSON type, or a field the op does not take
+    out_of_range,
+};
+/// "bad_json", "missing_id", "unknown_op", "missing_field", "invalid_field", "out_of_range".
+[[nodiscard]] std::string_view to_string(CommandErrorKind kind) noexcept;
+
+struct CommandError {
+    CommandErrorKind kind = CommandErrorKind::bad_json;
+    std::string message;    ///< names the field and what is expected
+    nlohmann::json id;      ///< null when the command had no usable id
+    std::string op;         ///< empty when unknown
+};
+
+using ParseResult = std::variant<ParsedCommand, CommandError>;
+
+[[nodiscard]] ParseResult parse_command(std::string_view payload, CommandSet set);
+
+/// The ops of @p set, for error messages and docs.
+[[nodiscard]] std::vector<std::string_view> command_ops(CommandSet set);
+
+}  // namespace fieldbridge::northbound::mqtt

@@ -1,0 +1,484 @@
+#include "northbound/mqtt/mqtt_bridge.hpp"
+
+#include <algorithm>
+#include <set>
+#include <utility>
+
+#include <asio/post.hpp>
+
+#include "northbound/mqtt/command_parser.hpp"
+#include "northbound/mqtt/command_runner.hpp"
+#include "northbound/mqtt/payloads.hpp"
+
+namespace fieldbridge::northbound::mqtt {
+
+using engine::LogLevel;
+using nlohmann::json;
+
+BridgeSettings bridge_settings(const config::MqttConfig& config) {
+    BridgeSettings s;
+    s.prefix = config.prefix;
+    s.qos = config.qos;
+    s.throttle.min_interval = config.min_interval;
+    s.throttle.heartbeat = config.heartbeat;
+    for (const auto& [field, band] : config.deadband) s.throttle.deadband.emplace(field, band);
+    s.diag_period = config.diag_period;
+    s.reconnect_initial = config.reconnect_backoff.initial;
+    s.reconnect_max = config.reconnect_backoff.max;
+    return s;
+}
+
+class Bridge::Impl : public std::enable_shared_from_this<Impl> {
+public:
+    Impl(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log)
+        : io_(io),
+          s_(std::move(settings)),
+          client_(std::move(client)),
+          log_(std::move(log)),
+          outbox_(s_.outbox_capacity),
+          wake_timer_(io),
+          diag_timer_(io),
+          reconnect_timer_(io),
+          stop_timer_(io),
+          backoff_(s_.reconnect_initial) {}
+
+    struct Device {
+        std::shared_ptr<DeviceSource> source;
+        StateThrottle throttle;
+        AlarmTracker alarms;
+        std::string state_topic;
+        std::string alarm_topic;
+        bool scheduled = false;
+    };
+
+    void set_sources(std::vector<std::shared_ptr<DeviceSource>> sources) {
+        for (auto& [name, device] : devices_) device->source->set_listener({});
+        devices_.clear();
+        for (auto& source : sources) {
+            auto device = std::make_unique<Device>(Device{source, StateThrottle(s_.throttle), AlarmTracker(s_.alarms),
+                                                          topic(source->name(), "state"),
+                                                          topic(source->name(), "alarm"), false});
+            const std::weak_ptr<Impl> weak = weak_from_this();
+            const std::string name = source->name();
+            const DeviceSource* identity = source.get();
+            source->set_listener(SourceListener{
+                [weak, name, identity] {
+                    if (auto self = weak.lock()) self->schedule(name, identity);
+                },
+                [weak, name, identity](const engine::DeviceNotice& notice) {
+                    if (auto self = weak.lock()) self->notice(name, identity, notice);
+                }});
+            devices_[name] = std::move(device);
+        }
+        if (started_ && !stopping_) evaluate_all();
+    }
+
+    void start() {
+        if (started_) return;
+        started_ = true;
+        const std::weak_ptr<Impl> weak = weak_from_this();
+        ClientEvents events;
+        events.connected = [weak] { if (auto self = weak.lock()) self->on_connected(); };
+        events.connect_failed = [weak](const std::string& reason) {
+            if (auto self = weak.lock()) self->on_connect_failed(reason);
+        };
+        events.connection_lost = [weak](const std::string& cause) {
+            if (auto self = weak.lock()) self->on_connection_lost(cause);
+        };
+        events.message = [weak](Message m) { if (auto self = weak.lock()) self->on_message(std::move(m)); };
+        events.published = [weak](std::uint64_t id, bool ok) {
+            if (auto self = weak.lock()) self->on_published(id, ok);
+        };
+        client_->set_events(std::move(events));
+        log(LogLevel::info, "MQTT: connecting to the broker; topics under " + s_.prefix + "/");
+        client_->connect();
+        evaluate_all();
+        arm_diag();
+    }
+
+    void stop(std::function<void()> done) {
+        if (stopping_) {
+            asio::post(io_, std::move(done));
+            return;
+        }
+        stopping_ = true;
+        stop_done_ = std::move(done);
+        wake_timer_.cancel();
+        diag_timer_.cancel();
+        reconnect_timer_.cancel();
+        outbox_.clear();
+        if (!client_->connected()) {
+            finish_stop();
+            return;
+        }
+        offline_id_ = client_->publish(Message{status_topic(), "offline", s_.qos, true});
+        if (offline_id_ == 0) {
+            disconnect();
+            return;
+        }
+        // Wait for the broker to take `offline`, not forever.
+        stop_timer_.expires_after(s_.stop_timeout);
+        stop_timer_.async_wait([weak = weak_from_this()](const std::error_code& error) {
+            if (auto self = weak.lock(); self && !error) self->disconnect();
+        });
+    }
+
+    /// The owner is going away: nothing runs after this.
+    void shutdown() {
+        for (auto& [name, device] : devices_) device->source->set_listener({});
+        devices_.clear();
+        client_->set_events({});
+        wake_timer_.cancel();
+        diag_timer_.cancel();
+        reconnect_timer_.cancel();
+        stop_timer_.cancel();
+    }
+
+    [[nodiscard]] bool connected() const noexcept { return client_->connected(); }
+
+    [[nodiscard]] BridgeStats stats() const {
+        BridgeStats s = stats_;
+        s.dropped = outbox_.dropped();
+        s.superseded = outbox_.superseded();
+        s.in_flight = in_flight_.size();
+        s.queued = outbox_.size();
+        return s;
+    }
+
+    const BridgeSettings& settings() const noexcept { return s_; }
+    DiagProvider diag_;
+
+private:
+    [[nodiscard]] std::string topic(const std::string& device, const char* leaf) const {
+        return s_.prefix + "/" + device + "/" + leaf;
+    }
+    [[nodiscard]] std::string status_topic() const { return s_.prefix + "/status"; }
+
+    void log(LogLevel level, const std::string& message) const { log_(level, message); }
+
+    // ---- connection -----------------------------------------------------------
+
+    void on_connected() {
+        if (stopping_) return;
+        ++stats_.connects;
+        backoff_ = s_.reconnect_initial;
+        log(LogLevel::info, "MQTT: connected; publishing availability, state and alarms");
+        client_->subscribe(s_.prefix + "/+/cmd", s_.qos);
+        outbox_.put_first(Message{status_topic(), "online", s_.qos, true});
+        // The broker may have lost every retained value (restarted without
+        // persistence): publish everything again.
+        const ClockPair clock = ClockPair::now();
+        for (auto& [name, device] : devices_) {
+            device->throttle.reset();
+            outbox_.put(alarm_set(name, *device, clock));
+        }
+        evaluate_all();
+        pump();
+    }
+
+    void on_connect_failed(const std::string& reason) {
+        ++stats_.connect_failures;
+        if (stopping_) return;
+        log(LogLevel::warning, "MQTT: cannot connect to the broker (" + reason + "); retrying in " +
+                                   std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(backoff_).count()) +
+                                   " ms; Modbus TCP and the lines are not affected");
+        schedule_reconnect();
+    }
+
+    void on_connection_lost(const std::string& cause) {
+        ++stats_.connection_losses;
+        in_flight_.clear();
+        if (stopping_) return;
+        log(LogLevel::warning, "MQTT: connection to the broker lost (" + cause + "); reconnecting");
+        schedule_reconnect();
+    }
+
+    void schedule_reconnect() {
+        reconnect_timer_.expires_after(backoff_);
+        backoff_ = std::min(backoff_ * 2, s_.reconnect_max);
+        reconnect_timer_.async_wait([weak = weak_from_this()](const std::error_code& error) {
+            if (auto self = weak.lock(); self && !error && !self->stopping_) self->client_->connect();
+        });
+    }
+
+    void disconnect() {
+        stop_timer_.cancel();
+        client_->disconnect(s_.stop_timeout, [weak = weak_from_this()] {
+            if (auto self = weak.lock()) self->finish_stop();
+        });
+    }
+
+    void finish_stop() {
+        auto done = std::move(stop_done_);
+        stop_done_ = nullptr;
+        if (done) asio::post(io_, std::move(done));
+    }
+
+    // ---- publishing -----------------------------------------------------------
+
+    void send(Message message) {
+        outbox_.put(std::move(message));
+        pump();
+    }
+
+    void pump() {
+        while (!stopping_ && client_->connected() && in_flight_.size() < s_.max_in_flight && !outbox_.empty()) {
+            Message m = *outbox_.take();
+            const std::uint64_t id = client_->publish(m);
+            if (id == 0) {
+                ++stats_.publish_failures;
+                break;
+            }
+            in_flight_.insert(id);
+        }
+    }
+
+    void on_published(std::uint64_t id, bool ok) {
+        if (id == offline_id_ && offline_id_ != 0) {
+            offline_id_ = 0;
+            disconnect();
+            return;
+        }
+        if (in_flight_.erase(id) == 0) return;  // from an earlier connection
+        if (ok) {
+            ++stats_.published;
+        } else {
+            ++stats_.publish_failures;
+        }
+        pump();
+    }
+
+    // ---- devices --------------------------------------------------------------
+
+    [[nodiscard]] Message alarm_set(const std::string& name, const Device& device, const ClockPair& clock) const {
+        return Message{device.alarm_topic, alarm_set_payload(name, device.alarms.active(), clock).dump(), s_.qos, true};
+    }
+
+    Device* find(const std::string& name, const DeviceSource* identity) {
+        const auto it = devices_.find(name);
+        if (it == devices_.end() || it->second->source.get() != identity) return nullptr;
+        return it->second.get();
+    }
+
+    void schedule(const std::string& name, const DeviceSource* identity) {
+        Device* device = find(name, identity);
+        if (device == nullptr || device->scheduled || stopping_) return;
+        device->scheduled = true;
+        asio::post(io_, [weak = weak_from_this(), name, identity] {
+            auto self = weak.lock();
+            if (!self) return;
+            Device* d = self->find(name, identity);
+            if (d == nullptr) return;
+            d->scheduled = false;
+            if (self->stopping_) return;
+            self->evaluate(name, *d, engine::Clock::now());
+            self->arm_wake();
+            self->pump();
+        });
+    }
+
+    void notice(const std::string& name, const DeviceSource* identity, const engine::DeviceNotice& notice) {
+        Device* device = find(name, identity);
+        if (device == nullptr) return;
+        device->alarms.notice(notice, engine::Clock::now());
+        schedule(name, identity);
+    }
+
+    void evaluate(const std::string& name, Device& device, engine::TimePoint now) {
+        const SourceState state = device.source->state();
+        const std::vector<AlarmEvent> events = device.alarms.update(device.source->alarms(), state.online, now);
+        const ClockPair clock = ClockPair::now();
+        for (const AlarmEvent& event : events) {
+            ++stats_.alarm_events;
+            log(LogLevel::info, "MQTT: " + name + " alarm " + event.alarm.code +
+                                    (event.transition == AlarmTransition::raised ? " raised: " : " cleared: ") +
+                                    event.alarm.text);
+            outbox_.put(Message{device.alarm_topic, alarm_event_payload(name, event, clock).dump(), s_.qos, false});
+        }
+        if (!events.empty()) outbox_.put(alarm_set(name, device, clock));
+        if (client_->connected() && device.throttle.due(state, now)) {
+            ++stats_.state_messages;
+            outbox_.put(Message{device.state_topic,
+                                state_payload(name, device.source->type(), state, clock).dump(), s_.qos, true});
+            device.throttle.published(state, now);
+        }
+        // Remember when to look again.
+        const auto consider = [&](std::optional<engine::TimePoint> t) {
+            if (t && (!device_wake_ || *t < *device_wake_)) device_wake_ = t;
+        };
+        if (client_->connected()) consider(device.throttle.next_check(state));
+        consider(device.alarms.next_deadline());
+    }
+
+    void evaluate_all() {
+        if (stopping_) return;
+        const engine::TimePoint now = engine::Clock::now();
+        for (auto& [name, device] : devices_) evaluate(name, *device, now);
+        arm_wake();
+        pump();
+    }
+
+    /// One timer for every device: the nearest hold / heartbeat, or the watch period.
+    void arm_wake() {
+        if (!started_ || stopping_) return;
+        engine::TimePoint at = engine::Clock::now() + s_.watch_period;
+        if (device_wake_ && *device_wake_ < at) at = *device_wake_;
+        device_wake_.reset();
+        if (wake_armed_ && wake_at_ <= at) return;
+        wake_armed_ = true;
+        wake_at_ = at;
+        wake_timer_.expires_at(at);
+        wake_timer_.async_wait([weak = weak_from_this()](const std::error_code& error) {
+            auto self = weak.lock();
+            if (!self || error) return;
+            self->wake_armed_ = false;
+            self->evaluate_all();
+        });
+    }
+
+    // ---- diagnostics ----------------------------------------------------------
+
+    void arm_diag() {
+        diag_timer_.expires_after(s_.diag_period);
+        diag_timer_.async_wait([weak = weak_from_this()](const std::error_code& error) {
+            auto self = weak.lock();
+            if (!self || error || self->stopping_) return;
+            self->publish_diag();
+            self->arm_diag();
+        });
+    }
+
+    void publish_diag() {
+        if (!client_->connected()) return;  // counters are a snapshot: the next one will do
+        json payload = diag_ ? diag_() : json::object();
+        if (!payload.is_object()) payload = json::object();
+        const BridgeStats s = stats();
+        payload["mqtt"] = {{"connects", s.connects},
+                           {"connect_failures", s.connect_failures},
+                           {"connection_losses", s.connection_losses},
+                           {"published", s.published},
+                           {"publish_failures", s.publish_failures},
+                           {"dropped", s.dropped},
+                           {"superseded", s.superseded},
+                           {"state_messages", s.state_messages},
+                           {"alarm_events", s.alarm_events},
+                           {"commands", s.commands},
+                           {"commands_failed", s.commands_failed},
+                           {"in_flight", s.in_flight},
+                           {"queued", s.queued}};
+        const WallTime now = WallClock::now();
+        payload["time"] = iso8601_utc(now);
+        payload["time_ms"] = epoch_ms(now);
+        send(Message{s_.prefix + "/diag", payload.dump(), s_.qos, false});
+    }
+
+    // ---- commands -------------------------------------------------------------
+
+    void on_message(Message message) {
+        // <prefix>/<device>/cmd, one level for the device.
+        const std::string head = s_.prefix + "/";
+        const std::string tail = "/cmd";
+        const std::string& t = message.topic;
+        if (t.size() <= head.size() + tail.size() || t.compare(0, head.size(), head) != 0 ||
+            t.compare(t.size() - tail.size(), tail.size(), tail) != 0) {
+            return;
+        }
+        const std::string name = t.substr(head.size(), t.size() - head.size() - tail.size());
+        if (name.find('/') != std::string::npos) return;
+        handle_command(name, message);
+    }
+
+    void handle_command(const std::string& name, const Message& message) {
+        ++stats_.commands;
+        const ParseResult parsed = [&]() -> ParseResult {
+            const auto it = devices_.find(name);
+            const CommandSet set = it == devices_.end() ? CommandSet::generic : it->second->source->command_set();
+            return parse_command(message.payload, set);
+        }();
+        json id;
+        std::string op;
+        if (const auto* error = std::get_if<CommandError>(&parsed)) {
+            id = error->id;
+            op = error->op;
+        } else {
+            id = std::get<ParsedCommand>(parsed).id;
+            op = std::get<ParsedCommand>(parsed).op;
+        }
+        const auto refuse = [&](std::string kind, std::string text) {
+            answer(name, id, op, CommandOutcome{false, std::move(kind), std::move(text), std::nullopt});
+        };
+        const auto it = devices_.find(name);
+        if (it == devices_.end()) {
+            refuse("unknown_device", "no device '" + name + "' on this gateway");
+            return;
+        }
+        if (message.retained) {
+            // A retained command would run again on every reconnect: never executed.
+            refuse("retained", "retained commands are not executed; publish the command without the retain flag "
+                               "and clear the retained message");
+            return;
+        }
+        if (stopping_) {
+            refuse("unavailable", "the gateway is stopping");
+            return;
+        }
+        if (!it->second->source->commands_enabled()) {
+            refuse("commands_disabled", "commands are disabled for '" + name + "' (mqtt_commands: false)");
+            return;
+        }
+        if (const auto* error = std::get_if<CommandError>(&parsed)) {
+            refuse(std::string(to_string(error->kind)), error->message);
+            return;
+        }
+        const auto& command = std::get<ParsedCommand>(parsed);
+        run_command(io_, it->second->source, command.requests,
+                    [weak = weak_from_this(), name, id, op](CommandOutcome outcome) {
+                        if (auto self = weak.lock()) self->answer(name, id, op, outcome);
+                    });
+    }
+
+    void answer(const std::string& name, const json& id, const std::string& op, const CommandOutcome& outcome) {
+        if (!outcome.ok) ++stats_.commands_failed;
+        log(outcome.ok ? LogLevel::info : LogLevel::warning,
+            "MQTT: command " + id.dump() + " '" + op + "' to " + name +
+                (outcome.ok ? std::string(": ok") : ": " + outcome.error + ": " + outcome.message));
+        send(Message{topic(name, "cmd/result"), command_result_payload(name, id, op, outcome, ClockPair::now()).dump(),
+                     s_.qos, false});
+    }
+
+    asio::io_context& io_;
+    BridgeSettings s_;
+    std::unique_ptr<Client> client_;
+    engine::LogSink log_;
+    Outbox outbox_;
+    std::map<std::string, std::unique_ptr<Device>, std::less<>> devices_;
+    asio::steady_timer wake_timer_;
+    asio::steady_timer diag_timer_;
+    asio::steady_timer reconnect_timer_;
+    asio::steady_timer stop_timer_;
+    engine::Duration backoff_;
+    bool started_ = false;
+    bool stopping_ = false;
+    bool wake_armed_ = false;
+    engine::TimePoint wake_at_{};
+    std::optional<engine::TimePoint> device_wake_;
+    std::set<std::uint64_t> in_flight_;
+    std::uint64_t offline_id_ = 0;
+    std::function<void()> stop_done_;
+    BridgeStats stats_;
+};
+
+Bridge::Bridge(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log)
+    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(client), std::move(log))) {}
+
+Bridge::~Bridge() { impl_->shutdown(); }
+
+void Bridge::set_sources(std::vector<std::shared_ptr<DeviceSource>> sources) { impl_->set_sources(std::move(sources)); }
+void Bridge::set_diag_provider(DiagProvider provider) { impl_->diag_ = std::move(provider); }
+void Bridge::start() { impl_->start(); }
+void Bridge::stop(std::function<void()> done) { impl_->stop(std::move(done)); }
+bool Bridge::connected() const noexcept { return impl_->connected(); }
+BridgeStats Bridge::stats() const { return impl_->stats(); }
+const BridgeSettings& Bridge::settings() const noexcept { return impl_->settings(); }
+
+}  // namespace fieldbridge::northbound::mqtt

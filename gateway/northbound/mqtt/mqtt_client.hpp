@@ -1,0 +1,53 @@
+#pragma once
+/// @file mqtt_client.hpp
+/// The seam between the bridge and an MQTT client library (paho_client.hpp is the
+/// real one). Every event is delivered on the gateway's loop thread; no call blocks.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace fieldbridge::northbound::mqtt {
+
+struct Message {
+    std::string topic;
+    std::string payload;
+    int qos = 1;
+    bool retained = false;
+};
+
+/// Callbacks of a client; all run on the loop thread.
+struct ClientEvents {
+    std::function<void()> connected;
+    /// A connect() that did not succeed (the reason as the library gives it).
+    std::function<void(const std::string& reason)> connect_failed;
+    std::function<void(const std::string& cause)> connection_lost;
+    std::function<void(Message message)> message;
+    /// The publication @p id (from publish()) was handed over (QoS 0) or acknowledged
+    /// (QoS 1/2): @p ok; or failed: !@p ok.
+    std::function<void(std::uint64_t id, bool ok)> published;
+};
+
+class Client {
+public:
+    Client() = default;
+    virtual ~Client() = default;
+    Client(const Client&) = delete;
+    Client& operator=(const Client&) = delete;
+
+    virtual void set_events(ClientEvents events) = 0;
+    /// Starts one connection attempt (with the will set up at construction); the
+    /// outcome comes as connected or connect_failed. No automatic reconnect: the
+    /// bridge decides when to try again.
+    virtual void connect() = 0;
+    /// Queues a publication; returns its id, or 0 when it cannot be queued (not
+    /// connected, library refused): nothing will be reported for it then.
+    [[nodiscard]] virtual std::uint64_t publish(const Message& message) = 0;
+    virtual void subscribe(const std::string& filter, int qos) = 0;
+    /// A clean disconnect (no will), waiting at most @p timeout for what is in flight;
+    /// @p done runs on the loop thread afterwards, whatever happened.
+    virtual void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) = 0;
+    [[nodiscard]] virtual bool connected() const = 0;
+};
+
+}  // namespace fieldbridge::northbound::mqtt

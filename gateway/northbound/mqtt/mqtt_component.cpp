@@ -1,0 +1,142 @@
+#include "northbound/mqtt/mqtt_component.hpp"
+
+#include <utility>
+
+#include <asio/post.hpp>
+
+#include "daemon/engine_component.hpp"
+#include "northbound/mqtt/paho_client.hpp"
+
+namespace fieldbridge::northbound::mqtt {
+
+ClientFactory paho_client_factory() {
+    return [](asio::io_context& io, const config::MqttConfig& config, const std::string& will_topic) {
+        return std::unique_ptr<Client>(std::make_unique<PahoClient>(io, paho_options(config, will_topic)));
+    };
+}
+
+MqttComponent::MqttComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger, EngineAccess engine,
+                             ClientFactory clients)
+    : io_(io), logger_(std::move(logger)), engine_(std::move(engine)), clients_(std::move(clients)) {}
+
+MqttComponent::~MqttComponent() {
+    *alive_ = false;
+    bridge_.reset();
+    // The engine may already be gone (stopped after us): never touch the agents.
+    detach_sources();
+}
+
+void MqttComponent::start(daemon::StartContext& context) {
+    config_ = context.config();
+    build();
+}
+
+void MqttComponent::build() {
+    if (!config_->mqtt.enabled) {
+        logger_->info("MQTT: off (no mqtt section, or enabled: false)");
+        return;
+    }
+    const config::MqttConfig& mqtt = config_->mqtt;
+    // Throws (with the URI) when the client library refuses the configuration: the
+    // daemon then refuses to start.
+    auto client = clients_(io_, mqtt, mqtt.prefix + "/status");
+    bridge_ = std::make_unique<Bridge>(io_, bridge_settings(mqtt), std::move(client), daemon::engine_log_sink(logger_));
+    bridge_->set_diag_provider([this] {
+        nlohmann::json out = nlohmann::json::object();
+        if (engine::Engine* e = engine_ ? engine_() : nullptr) out = engine_diag_.collect(*e, engine::Clock::now());
+        for (const auto& provider : diag_) {
+            const nlohmann::json extra = provider();
+            if (extra.is_object()) out.update(extra);
+        }
+        return out;
+    });
+    if (!refresh_pending_) refresh_sources();
+    bridge_->start();
+    logger_->info("MQTT: broker {}, client id {}, prefix {}, MQTT {}", mqtt.uri, mqtt.client_id, mqtt.prefix,
+                  config::to_string(mqtt.version));
+}
+
+void MqttComponent::refresh_sources() {
+    detach_sources();
+    if (!bridge_) return;
+    engine::Engine* e = engine_ ? engine_() : nullptr;
+    std::vector<std::shared_ptr<DeviceSource>> sources;
+    if (e != nullptr) {
+        for (const engine::DeviceEntry& entry : e->devices()) {
+            auto source = std::make_shared<AgentSource>(io_, *entry.agent, entry.mqtt_commands);
+            sources_.push_back(source);
+            sources.push_back(std::move(source));
+        }
+    }
+    for (const auto& provider : source_providers_) {
+        for (auto& source : provider()) sources.push_back(std::move(source));
+    }
+    bridge_->set_sources(std::move(sources));
+}
+
+void MqttComponent::detach_sources() {
+    for (auto& source : sources_) source->detach();
+    sources_.clear();
+}
+
+void MqttComponent::stop(daemon::StopContext& context) {
+    if (!bridge_) {
+        detach_sources();
+        return;
+    }
+    auto ticket = std::make_shared<daemon::CompletionBarrier::Ticket>(
+        context.expect_finished("MQTT offline publication"));
+    bridge_->stop([ticket] { ticket->done(); });
+    // The engine stops after this component: the sources must not outlive it.
+    bridge_->set_sources({});
+    detach_sources();
+}
+
+void MqttComponent::retire(std::unique_ptr<Bridge> bridge) {
+    if (!bridge) return;
+    bridge->set_sources({});
+    // Kept alive until its `offline` is out (or the stop timeout passed).
+    auto holder = std::make_shared<std::unique_ptr<Bridge>>(std::move(bridge));
+    (*holder)->stop([holder]() mutable { holder->reset(); });
+}
+
+void MqttComponent::apply(std::shared_ptr<const config::Config> config) {
+    const bool mqtt_changed = !config_ || config_->mqtt != config->mqtt || config_->gateway.id != config->gateway.id;
+    const bool engine_rebuilt = !config_ || config_->lines != config->lines;
+    config_ = std::move(config);
+    if (engine_rebuilt) {
+        // The engine component rebuilds its agents on this same reload, maybe
+        // already: forget the old ones now, take the new ones once every component
+        // has applied the configuration.
+        if (bridge_) bridge_->set_sources({});
+        detach_sources();
+        refresh_pending_ = true;
+    }
+    if (mqtt_changed) {
+        logger_->info("MQTT: configuration changed; reconnecting");
+        retire(std::move(bridge_));
+        engine_diag_ = EngineDiag{};
+        build();
+    }
+    if (engine_rebuilt) {
+        asio::post(io_, [this, alive = alive_] {
+            if (!*alive) return;
+            refresh_pending_ = false;
+            refresh_sources();
+        });
+    }
+}
+
+void MqttComponent::add_diag(DiagProvider provider) { diag_.push_back(std::move(provider)); }
+
+void MqttComponent::add_sources(SourceProvider provider) {
+    source_providers_.push_back(std::move(provider));
+    if (bridge_ && !refresh_pending_) refresh_sources();
+}
+
+std::string MqttComponent::status() const {
+    if (!bridge_) return "MQTT off";
+    return bridge_->connected() ? "MQTT connected" : "MQTT connecting";
+}
+
+}  // namespace fieldbridge::northbound::mqtt

@@ -1,0 +1,270 @@
+#include "northbound/mqtt/paho_client.hpp"
+
+#include <cstdint>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <utility>
+
+#include <asio/post.hpp>
+#include <mqtt/async_client.h>
+
+namespace fieldbridge::northbound::mqtt {
+
+namespace {
+
+[[nodiscard]] void* context_of(std::uint64_t id) noexcept {
+    return reinterpret_cast<void*>(static_cast<std::uintptr_t>(id));
+}
+/// What the loop needs of a Paho token (tokens belong to Paho and do not copy).
+struct TokenInfo {
+    std::uint64_t id = 0;
+    std::string reason;
+};
+
+[[nodiscard]] TokenInfo info_of(const ::mqtt::token& token) {
+    TokenInfo info;
+    info.id = static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(token.get_user_context()));
+    info.reason = ::mqtt::exception::printable_error(token.get_return_code(), token.get_reason_code());
+    return info;
+}
+
+}  // namespace
+
+PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic) {
+    PahoOptions o;
+    o.uri = config.uri;
+    o.client_id = config.client_id;
+    o.username = config.username;
+    o.password = config.password;
+    o.tls = config.uses_tls();
+    o.tls_files = config.tls;
+    o.version = config.version;
+    o.keep_alive = std::chrono::duration_cast<std::chrono::seconds>(config.keep_alive);
+    o.clean_session = config.clean_session;
+    o.will = Message{will_topic, "offline", config.qos, true};
+    return o;
+}
+
+/// Everything Paho's threads may reach. Paho callbacks only call post(); the
+/// posted functions run on the loop and only while the client exists.
+class PahoClient::Core {
+public:
+    /// An action listener that posts its outcome to the loop.
+    class Listener final : public ::mqtt::iaction_listener {
+    public:
+        using Handler = std::function<void(Core&, const TokenInfo&, bool ok)>;
+        Listener(Core& core, Handler handler) : core_(core), handler_(std::move(handler)) {}
+
+    private:
+        void on_success(const ::mqtt::token& token) override { relay(token, true); }
+        void on_failure(const ::mqtt::token& token) override { relay(token, false); }
+        void relay(const ::mqtt::token& token, bool ok) {
+            // What the loop needs is copied here: the token belongs to Paho.
+            std::function<void(Core&)> event;
+            try {
+                event = [handler = handler_, copied = info_of(token), ok](Core& core) { handler(core, copied, ok); };
+            } catch (...) {
+                return;
+            }
+            core_.post(std::move(event));
+        }
+        Core& core_;
+        Handler handler_;
+    };
+
+    Core(asio::io_context& io, PahoOptions options) : io_(io), options_(std::move(options)) {}
+    Core(const Core&) = delete;
+    Core& operator=(const Core&) = delete;
+    ~Core() = default;
+
+    /// From any thread: runs @p event on the loop unless the client is gone by then.
+    void post(std::function<void(Core&)> event) noexcept {
+        try {
+            const std::lock_guard lock(mutex_);
+            if (!accepting_) return;
+            asio::post(io_, [alive = alive_, this, event = std::move(event)] {
+                if (*alive) event(*this);
+            });
+        } catch (...) {
+            // A Paho thread must never see an exception (allocation failure here).
+        }
+    }
+
+    /// Loop thread: no more events, and none of those already posted will run.
+    void close() noexcept {
+        {
+            const std::lock_guard lock(mutex_);
+            accepting_ = false;
+        }
+        *alive_ = false;
+    }
+
+    asio::io_context& io_;
+    PahoOptions options_;
+    std::unique_ptr<::mqtt::async_client> client_;
+    ClientEvents events_;
+    bool connected_ = false;
+    std::uint64_t next_id_ = 1;
+    std::map<std::uint64_t, std::function<void()>> disconnects_;
+
+    Listener connect_listener_{*this, [](Core& core, const TokenInfo& token, bool ok) {
+                                   core.connected_ = ok;
+                                   if (ok) {
+                                       if (core.events_.connected) core.events_.connected();
+                                   } else if (core.events_.connect_failed) {
+                                       core.events_.connect_failed(token.reason);
+                                   }
+                               }};
+    Listener publish_listener_{*this, [](Core& core, const TokenInfo& token, bool ok) {
+                                   if (core.events_.published) core.events_.published(token.id, ok);
+                               }};
+    Listener subscribe_listener_{*this, [](Core&, const TokenInfo&, bool) {}};
+    Listener disconnect_listener_{*this, [](Core& core, const TokenInfo& token, bool) {
+                                      core.connected_ = false;
+                                      const auto it = core.disconnects_.find(token.id);
+                                      if (it != core.disconnects_.end()) {
+                                          auto done = std::move(it->second);
+                                          core.disconnects_.erase(it);
+                                          if (done) done();
+                                      }
+                                  }};
+
+private:
+    std::mutex mutex_;
+    bool accepting_ = true;
+    // Shared with the posted handlers: they may run after the Core is gone.
+    std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+PahoClient::PahoClient(asio::io_context& io, PahoOptions options)
+    : core_(std::make_shared<Core>(io, std::move(options))) {
+    const PahoOptions& o = core_->options_;
+    const int version = o.version == config::MqttVersion::v5 ? MQTTVERSION_5 : MQTTVERSION_3_1_1;
+    try {
+        // No persistence and no offline buffer: state is republished on reconnect.
+        core_->client_ = std::make_unique<::mqtt::async_client>(o.uri, o.client_id, ::mqtt::create_options(version));
+    } catch (const std::exception& e) {
+        throw std::runtime_error("MQTT: cannot create a client for " + o.uri + ": " + e.what() +
+                                 "; check mqtt.uri in the configuration");
+    }
+    Core* core = core_.get();
+    core_->client_->set_connection_lost_handler([core](const std::string& cause) {
+        core->post([cause](Core& c) {
+            c.connected_ = false;
+            if (c.events_.connection_lost) c.events_.connection_lost(cause.empty() ? "connection lost" : cause);
+        });
+    });
+    core_->client_->set_message_callback([core](::mqtt::const_message_ptr message) {
+        if (!message) return;
+        std::string topic;
+        std::string payload;
+        try {
+            topic = message->get_topic();
+            payload = message->to_string();
+        } catch (...) {
+            return;
+        }
+        const int qos = message->get_qos();
+        const bool retained = message->is_retained();
+        core->post([m = Message{std::move(topic), std::move(payload), qos, retained}](Core& c) mutable {
+            if (c.events_.message) c.events_.message(std::move(m));
+        });
+    });
+}
+
+PahoClient::~PahoClient() {
+    core_->close();
+    try {
+        core_->client_->disable_callbacks();
+        if (core_->client_->is_connected()) {
+            // Not a clean stop (that is disconnect()): leave without blocking the loop
+            // for long; the broker publishes the will.
+            core_->client_->disconnect(0)->wait_for(std::chrono::milliseconds{100});
+        }
+    } catch (...) {
+        // Tearing down: Paho may refuse when the connection is already gone.
+    }
+    core_->client_.reset();
+}
+
+void PahoClient::set_events(ClientEvents events) { core_->events_ = std::move(events); }
+
+void PahoClient::connect() {
+    const PahoOptions& o = core_->options_;
+    try {
+        ::mqtt::connect_options options;
+        options.set_mqtt_version(o.version == config::MqttVersion::v5 ? MQTTVERSION_5 : MQTTVERSION_3_1_1);
+        options.set_keep_alive_interval(static_cast<int>(o.keep_alive.count()));
+        if (o.version == config::MqttVersion::v5) {
+            options.set_clean_start(o.clean_session);
+        } else {
+            options.set_clean_session(o.clean_session);
+        }
+        options.set_connect_timeout(static_cast<int>(o.connect_timeout.count()));
+        options.set_automatic_reconnect(false);
+        options.set_max_inflight(o.max_inflight);
+        if (!o.username.empty()) options.set_user_name(o.username);
+        if (!o.password.empty()) options.set_password(o.password);
+        options.set_will(::mqtt::will_options(o.will.topic, o.will.payload, o.will.qos, o.will.retained));
+        if (o.tls) {
+            ::mqtt::ssl_options ssl;
+            if (!o.tls_files.ca_file.empty()) ssl.set_trust_store(o.tls_files.ca_file);
+            if (!o.tls_files.cert_file.empty()) ssl.set_key_store(o.tls_files.cert_file);
+            if (!o.tls_files.key_file.empty()) ssl.set_private_key(o.tls_files.key_file);
+            ssl.set_enable_server_cert_auth(o.tls_files.verify);
+            ssl.set_verify(o.tls_files.verify);
+            options.set_ssl(std::move(ssl));
+        }
+        core_->client_->connect(options, nullptr, core_->connect_listener_);
+    } catch (const std::exception& e) {
+        core_->post([reason = std::string(e.what())](Core& c) {
+            if (c.events_.connect_failed) c.events_.connect_failed(reason);
+        });
+    }
+}
+
+std::uint64_t PahoClient::publish(const Message& message) {
+    if (!core_->connected_) return 0;
+    const std::uint64_t id = core_->next_id_++;
+    try {
+        auto msg = ::mqtt::make_message(message.topic, message.payload, message.qos, message.retained);
+        core_->client_->publish(msg, context_of(id), core_->publish_listener_);
+        return id;
+    } catch (const std::exception&) {
+        // Not connected any more, or Paho's queue refused it: the bridge republishes
+        // state on the next connection.
+        return 0;
+    }
+}
+
+void PahoClient::subscribe(const std::string& filter, int qos) {
+    try {
+        core_->client_->subscribe(filter, qos, nullptr, core_->subscribe_listener_);
+    } catch (const std::exception&) {
+        // Lost the connection meanwhile: subscribed again on the next one.
+    }
+}
+
+void PahoClient::disconnect(std::chrono::milliseconds timeout, std::function<void()> done) {
+    const std::uint64_t id = core_->next_id_++;
+    try {
+        if (core_->client_->is_connected()) {
+            core_->disconnects_[id] = std::move(done);
+            core_->client_->disconnect(static_cast<int>(timeout.count()), context_of(id), core_->disconnect_listener_);
+            return;
+        }
+    } catch (const std::exception&) {
+        done = std::move(core_->disconnects_[id]);
+        core_->disconnects_.erase(id);
+    }
+    core_->connected_ = false;
+    core_->post([done = std::move(done)](Core&) {
+        if (done) done();
+    });
+}
+
+bool PahoClient::connected() const { return core_->connected_; }
+
+}  // namespace fieldbridge::northbound::mqtt

@@ -1,0 +1,58 @@
+#pragma once
+/// @file paho_client.hpp
+/// The Client seam over Eclipse Paho MQTT C++ (mqtt::async_client). Paho runs its
+/// own threads and calls back on them (paho.mqtt.cpp include/mqtt/async_client.h):
+/// every callback here only posts the event to the gateway's io_context, inside a
+/// try/catch wall, and does nothing once the client is being destroyed. No automatic
+/// reconnect and no offline buffering in Paho: the bridge owns both.
+// Standard headers before asio's (see daemon/periodic.hpp).
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include <asio/io_context.hpp>
+
+#include "config/config.hpp"
+#include "northbound/mqtt/mqtt_client.hpp"
+
+namespace fieldbridge::northbound::mqtt {
+
+struct PahoOptions {
+    std::string uri = "tcp://127.0.0.1:1883";
+    std::string client_id;
+    std::string username;  ///< empty: none
+    std::string password;  ///< empty: none
+    bool tls = false;      ///< ssl:// or wss://
+    config::MqttTlsConfig tls_files;
+    config::MqttVersion version = config::MqttVersion::v3_1_1;
+    std::chrono::seconds keep_alive{30};
+    bool clean_session = true;
+    Message will;  ///< `<prefix>/status` = "offline", retained
+    std::chrono::seconds connect_timeout{10};
+    /// QoS 1/2 publications awaiting their acknowledgement (Paho's maxInflight).
+    int max_inflight = 64;
+};
+
+/// The options of @p config with the will on @p will_topic.
+[[nodiscard]] PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic);
+
+class PahoClient final : public Client {
+public:
+    /// Throws std::runtime_error naming the URI when Paho refuses it.
+    PahoClient(asio::io_context& io, PahoOptions options);
+    ~PahoClient() override;
+
+    void set_events(ClientEvents events) override;
+    void connect() override;
+    [[nodiscard]] std::uint64_t publish(const Message& message) override;
+    void subscribe(const std::string& filter, int qos) override;
+    void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) override;
+    [[nodiscard]] bool connected() const override;
+
+    class Core;
+
+private:
+    std::shared_ptr<Core> core_;
+};
+
+}  // namespace fieldbridge::northbound::mqtt

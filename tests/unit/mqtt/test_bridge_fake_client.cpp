@@ -1,0 +1,186 @@
+// The bridge over a scripted client: bounded in-flight and outbox while the broker is
+// slow, back-off of reconnection attempts, clean stop, retained commands refused.
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "fake_source.hpp"
+#include "northbound/mqtt/mqtt_bridge.hpp"
+
+namespace {
+
+using namespace fbt;
+using namespace std::chrono_literals;
+using nlohmann::json;
+
+/// A client whose broker answers only when the test says so.
+class ScriptedClient final : public fm::Client {
+public:
+    struct Log {
+        std::vector<fm::Message> published;
+        std::vector<std::uint64_t> ids;
+        std::vector<fe::TimePoint> connects;
+        std::vector<std::string> subscriptions;
+        bool disconnected = false;
+        fm::ClientEvents events;
+        bool connected = false;
+        bool accept_connect = true;
+    };
+    explicit ScriptedClient(asio::io_context& io, std::shared_ptr<Log> log) : io_(io), log_(std::move(log)) {}
+
+    void set_events(fm::ClientEvents events) override { log_->events = std::move(events); }
+    void connect() override {
+        log_->connects.push_back(fe::Clock::now());
+        asio::post(io_, [log = log_] {
+            if (log->accept_connect) {
+                log->connected = true;
+                if (log->events.connected) log->events.connected();
+            } else if (log->events.connect_failed) {
+                log->events.connect_failed("connection refused");
+            }
+        });
+    }
+    std::uint64_t publish(const fm::Message& message) override {
+        if (!log_->connected) return 0;
+        log_->published.push_back(message);
+        log_->ids.push_back(next_);
+        return next_++;
+    }
+    void subscribe(const std::string& filter, int) override { log_->subscriptions.push_back(filter); }
+    void disconnect(std::chrono::milliseconds, std::function<void()> done) override {
+        log_->connected = false;
+        log_->disconnected = true;
+        asio::post(io_, std::move(done));
+    }
+    bool connected() const override { return log_->connected; }
+
+private:
+    asio::io_context& io_;
+    std::shared_ptr<Log> log_;
+    std::uint64_t next_ = 1;
+};
+
+fm::BridgeSettings settings() {
+    fm::BridgeSettings s;
+    s.prefix = "p";
+    s.throttle.min_interval = 0ms;
+    s.max_in_flight = 4;
+    s.outbox_capacity = 8;
+    s.reconnect_initial = 20ms;
+    s.reconnect_max = 80ms;
+    s.watch_period = 50ms;
+    return s;
+}
+
+void run(asio::io_context& io, std::chrono::milliseconds d) {
+    io.restart();
+    io.run_for(d);
+}
+
+}  // namespace
+
+TEST_CASE("bridge: at most max_in_flight unacknowledged publications; the rest wait, bounded, newest state kept") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    auto source = std::make_shared<FakeSource>(io, "g1");
+    bridge.set_sources({source});
+    bridge.start();
+    run(io, 30ms);
+    REQUIRE(log->connected);
+    CHECK(log->subscriptions == std::vector<std::string>{"p/+/cmd"});
+    REQUIRE(!log->published.empty());
+    CHECK(log->published[0].topic == "p/status");
+    CHECK(log->published[0].payload == "online");
+    CHECK(log->published[0].retained);
+
+    // The broker acknowledges nothing: many changes later, still 4 in flight and a
+    // bounded outbox holding the newest state.
+    for (int i = 0; i < 100; ++i) {
+        source->set_position(20.0 + i);
+        run(io, 2ms);
+    }
+    CHECK(log->published.size() == 4);
+    const auto stats = bridge.stats();
+    CHECK(stats.in_flight == 4);
+    CHECK(stats.queued <= 8);
+    // Acknowledge everything: the newest state goes out.
+    for (std::size_t k = 0; k < 20 && bridge.stats().in_flight > 0; ++k) {
+        const auto ids = log->ids;
+        for (auto id : ids) log->events.published(id, true);
+        log->ids.clear();
+        run(io, 5ms);
+    }
+    const auto last_state = [&] {
+        for (auto it = log->published.rbegin(); it != log->published.rend(); ++it) {
+            if (it->topic == "p/g1/state") return json::parse(it->payload);
+        }
+        return json();
+    }();
+    CHECK(last_state["fields"]["position_mm"] == 119.0);
+}
+
+TEST_CASE("bridge: reconnection attempts back off, doubling up to the maximum") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    log->accept_connect = false;
+    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    bridge.start();
+    const auto until = std::chrono::steady_clock::now() + 2s;
+    while (log->connects.size() < 6 && std::chrono::steady_clock::now() < until) run(io, 5ms);
+    REQUIRE(log->connects.size() >= 6);
+    // Gaps: >= 20, 40, 80, 80, 80 ms (timers never fire early).
+    const fe::Duration expected[] = {20ms, 40ms, 80ms, 80ms, 80ms};
+    for (std::size_t i = 0; i < 5; ++i) CHECK(log->connects[i + 1] - log->connects[i] >= expected[i]);
+    CHECK(bridge.stats().connect_failures >= 5);
+    log->accept_connect = true;
+    while (!bridge.connected() && std::chrono::steady_clock::now() < until + 1s) run(io, 5ms);
+    CHECK(bridge.connected());
+}
+
+TEST_CASE("bridge: a clean stop publishes offline, waits for it, then disconnects") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    bridge.start();
+    run(io, 20ms);
+    for (auto id : log->ids) log->events.published(id, true);
+    log->ids.clear();
+    bool stopped = false;
+    bridge.stop([&] { stopped = true; });
+    REQUIRE_FALSE(log->published.empty());
+    CHECK(log->published.back().payload == "offline");
+    CHECK(log->published.back().retained);
+    run(io, 20ms);
+    CHECK_FALSE(log->disconnected);  // waiting for the acknowledgement
+    log->events.published(log->ids.back(), true);
+    run(io, 20ms);
+    CHECK(log->disconnected);
+    CHECK(stopped);
+}
+
+TEST_CASE("bridge: a retained command is never executed") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    auto source = std::make_shared<FakeSource>(io, "g1");
+    bridge.set_sources({source});
+    bridge.start();
+    run(io, 20ms);
+    log->events.message(fm::Message{"p/g1/cmd", R"({"id":1,"op":"stop"})", 1, true});
+    for (auto id : log->ids) log->events.published(id, true);
+    run(io, 20ms);
+    CHECK(source->executed.empty());
+    bool answered = false;
+    for (const auto& m : log->published) {
+        if (m.topic == "p/g1/cmd/result") {
+            answered = true;
+            CHECK(json::parse(m.payload)["error"] == "retained");
+        }
+    }
+    CHECK(answered);
+    // Not retained: executed.
+    log->events.message(fm::Message{"p/g1/cmd", R"({"id":2,"op":"stop"})", 1, false});
+    run(io, 20ms);
+    CHECK(source->executed.size() == 1);
+}

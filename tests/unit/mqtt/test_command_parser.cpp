@@ -1,0 +1,161 @@
+// MQTT commands -> Modbus requests per command set; what the parser and the profiles refuse.
+#include <doctest/doctest.h>
+
+#include "engine/profiles/profile_factory.hpp"
+#include "northbound/mqtt/command_parser.hpp"
+
+namespace {
+
+namespace fe = fieldbridge::engine;
+namespace fm = fieldbridge::northbound::mqtt;
+namespace fp = fieldbridge::protocol;
+
+std::vector<fp::Request> requests(const std::string& payload, fm::CommandSet set) {
+    const auto result = fm::parse_command(payload, set);
+    if (const auto* error = std::get_if<fm::CommandError>(&result)) {
+        FAIL_CHECK("refused: " << error->message);
+        return {};
+    }
+    return std::get<fm::ParsedCommand>(result).requests;
+}
+
+fm::CommandError refused(const std::string& payload, fm::CommandSet set) {
+    const auto result = fm::parse_command(payload, set);
+    REQUIRE(std::holds_alternative<fm::CommandError>(result));
+    return std::get<fm::CommandError>(result);
+}
+
+fp::Request fc06(std::uint16_t a, std::uint16_t v) { return fp::WriteSingleRegisterRequest{a, v}; }
+fp::Request fc16(std::uint16_t a, std::vector<std::uint16_t> v) { return fp::WriteMultipleRegistersRequest{a, std::move(v)}; }
+
+using Rs = std::vector<fp::Request>;
+
+}  // namespace
+
+TEST_CASE("commands: XEG ops (seed 001 section 3.4)") {
+    using fm::CommandSet;
+    CHECK(requests(R"({"id":1,"op":"reset"})", CommandSet::xeg) == Rs{fc06(0x0610, 1)});
+    CHECK(requests(R"({"id":1,"op":"stop"})", CommandSet::xeg) == Rs{fc06(0x0620, 1)});
+    CHECK(requests(R"({"id":1,"op":"move","position_mm":17.5,"speed_mm_s":20})", CommandSet::xeg) ==
+          Rs{fc16(0x0630, {1750, 2000, 1})});
+    CHECK(requests(R"({"id":"e","op":"expert","direction":1,"stroke_mm":10,"speed_mm_s":20,"holding_stroke_mm":5,)"
+                   R"("holding_speed_mm_s":10,"force_pct":60})",
+                   CommandSet::xeg) == Rs{fc16(0x0640, {1, 1000, 2000, 500, 1000, 60, 1})});
+    CHECK(requests(R"({"id":1,"op":"trigger","index":5})", CommandSet::xeg) == Rs{fc06(0x0601, 5)});
+}
+
+TEST_CASE("commands: EXCD203MB ops, 32-bit values high word first") {
+    using fm::CommandSet;
+    CHECK(requests(R"({"id":1,"op":"abs","position":1600000})", CommandSet::excd) == Rs{fc16(0x0100, {0x0018, 0x6A00})});
+    CHECK(requests(R"({"id":1,"op":"rel","distance":-1})", CommandSet::excd) == Rs{fc16(0x0104, {0xFFFF, 0xFFFF})});
+    CHECK(requests(R"({"id":1,"op":"home"})", CommandSet::excd) == Rs{fc06(0x0107, 0)});
+    CHECK(requests(R"({"id":1,"op":"stop"})", CommandSet::excd) == Rs{fc06(0x0108, 0)});
+    CHECK(requests(R"({"id":1,"op":"stop","immediate":true})", CommandSet::excd) == Rs{fc06(0x0109, 0)});
+    CHECK(requests(R"({"id":1,"op":"jog","direction":"reverse","mode":"continuous"})", CommandSet::excd) ==
+          Rs{fc16(0x010A, {0xFF81, 0x5A20})});
+    CHECK(requests(R"({"id":1,"op":"jog","direction":"forward","mode":"inch"})", CommandSet::excd) ==
+          Rs{fc16(0x010A, {0, 1})});
+    CHECK(requests(R"({"id":1,"op":"jog_stop"})", CommandSet::excd) == Rs{fc06(0x010C, 0)});
+    CHECK(requests(R"({"id":1,"op":"set_register","address":18,"value":20})", CommandSet::excd) == Rs{fc06(0x0012, 20)});
+}
+
+TEST_CASE("commands: WTEC ops on the uniform map") {
+    using fm::CommandSet;
+    CHECK(requests(R"({"id":1,"op":"init"})", CommandSet::wtec) == Rs{fc06(0x0100, 1)});
+    CHECK(requests(R"({"id":1,"op":"grip"})", CommandSet::wtec) == Rs{fc06(0x0105, 0)});
+    CHECK(requests(R"({"id":1,"op":"grip","force_pct":50,"speed_pct":80})", CommandSet::wtec) ==
+          Rs{fc06(0x0103, 50), fc06(0x0104, 80), fc06(0x0105, 0)});
+    CHECK(requests(R"({"id":1,"op":"release","speed_pct":30})", CommandSet::wtec) == Rs{fc06(0x0104, 30), fc06(0x0105, 100)});
+    CHECK(requests(R"({"id":1,"op":"position","percent":40})", CommandSet::wtec) == Rs{fc06(0x0105, 40)});
+    CHECK(requests(R"({"id":1,"op":"force","percent":20})", CommandSet::wtec) == Rs{fc06(0x0103, 20)});
+    CHECK(requests(R"({"id":1,"op":"speed","percent":100})", CommandSet::wtec) == Rs{fc06(0x0104, 100)});
+    CHECK(requests(R"({"id":1,"op":"estop"})", CommandSet::wtec) == Rs{fc06(0x0102, 1)});
+}
+
+TEST_CASE("commands: R6 ops (seed 004 3.2.1, 3.2.2, 3.3.3)") {
+    using fm::CommandSet;
+    CHECK(requests(R"({"id":1,"op":"stop"})", CommandSet::r6) == Rs{fc06(0x4E20, 1)});
+    CHECK(requests(R"({"id":1,"op":"pause"})", CommandSet::r6) == Rs{fc06(0x4E21, 1)});
+    CHECK(requests(R"({"id":1,"op":"start"})", CommandSet::r6) == Rs{fc06(0x4E23, 1)});
+    CHECK(requests(R"({"id":1,"op":"clear_alarm","resume":"next"})", CommandSet::r6) == Rs{fc06(0x4E25, 1)});
+    CHECK(requests(R"({"id":1,"op":"clear_alarm","resume":"continue"})", CommandSet::r6) == Rs{fc06(0x4E26, 1)});
+    CHECK(requests(R"({"id":1,"op":"global_speed","percent":10})", CommandSet::r6) == Rs{fc06(0x4EE8, 100)});
+    CHECK(requests(R"({"id":1,"op":"output","board":0,"point":1,"on":true})", CommandSet::r6) ==
+          Rs{fc16(0x4E58, {0, 1, 1})});
+}
+
+TEST_CASE("commands: write_registers for every set, holding or coils") {
+    for (auto set : {fm::CommandSet::xeg, fm::CommandSet::excd, fm::CommandSet::wtec, fm::CommandSet::r6,
+                     fm::CommandSet::generic}) {
+        CHECK(requests(R"({"id":1,"op":"write_registers","address":16,"values":[1,2]})", set) == Rs{fc16(0x10, {1, 2})});
+        CHECK(requests(R"({"id":1,"op":"write_registers","address":16,"values":[7]})", set) == Rs{fc06(0x10, 7)});
+    }
+    CHECK(requests(R"({"id":1,"op":"write_registers","table":"coils","address":3,"values":[1]})", fm::CommandSet::generic) ==
+          Rs{fp::WriteSingleCoilRequest{3, true}});
+    CHECK(requests(R"({"id":1,"op":"write_registers","table":"coils","address":3,"values":[1,0]})",
+                   fm::CommandSet::generic) == Rs{fp::WriteMultipleCoilsRequest{3, {true, false}}});
+}
+
+TEST_CASE("commands: invalid commands are refused with a kind and a message, echoing the id when there is one") {
+    using fm::CommandErrorKind;
+    using fm::CommandSet;
+    CHECK(refused("not json", CommandSet::xeg).kind == CommandErrorKind::bad_json);
+    CHECK(refused("[1,2]", CommandSet::xeg).kind == CommandErrorKind::bad_json);
+    CHECK(refused(R"({"op":"stop"})", CommandSet::xeg).kind == CommandErrorKind::missing_id);
+    CHECK(refused(R"({"id":true,"op":"stop"})", CommandSet::xeg).kind == CommandErrorKind::missing_id);
+    const auto unknown = refused(R"({"id":"a","op":"fly"})", CommandSet::xeg);
+    CHECK(unknown.kind == CommandErrorKind::unknown_op);
+    CHECK(unknown.id == "a");
+    CHECK(unknown.message.find("move") != std::string::npos);  // lists the ops
+    CHECK(refused(R"({"id":1,"op":"abs","position":1})", CommandSet::xeg).kind == CommandErrorKind::unknown_op);
+    CHECK(refused(R"({"id":1})", CommandSet::xeg).kind == CommandErrorKind::unknown_op);
+    const auto missing = refused(R"({"id":2,"op":"move","position_mm":1})", CommandSet::xeg);
+    CHECK(missing.kind == CommandErrorKind::missing_field);
+    CHECK(missing.id == 2);
+    CHECK(missing.op == "move");
+    CHECK(missing.message.find("speed_mm_s") != std::string::npos);
+    CHECK(refused(R"({"id":1,"op":"move","position_mm":"1","speed_mm_s":1})", CommandSet::xeg).kind ==
+          CommandErrorKind::invalid_field);
+    CHECK(refused(R"({"id":1,"op":"move","position_mm":-1,"speed_mm_s":1})", CommandSet::xeg).kind ==
+          CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"move","position_mm":1,"speed_mm_s":1,"sped":2})", CommandSet::xeg).kind ==
+          CommandErrorKind::invalid_field);
+    CHECK(refused(R"({"id":1,"op":"trigger","index":64})", CommandSet::xeg).kind == CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"trigger","index":1.5})", CommandSet::xeg).kind == CommandErrorKind::invalid_field);
+    CHECK(refused(R"({"id":1,"op":"abs","position":8300001})", CommandSet::excd).kind == CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"jog","direction":"up","mode":"inch"})", CommandSet::excd).kind ==
+          CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"grip","force_pct":10})", CommandSet::wtec).kind == CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"clear_alarm"})", CommandSet::r6).kind == CommandErrorKind::missing_field);
+    CHECK(refused(R"({"id":1,"op":"output","board":8,"point":1,"on":true})", CommandSet::r6).kind ==
+          CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"write_registers","address":70000,"values":[1]})", CommandSet::generic).kind ==
+          CommandErrorKind::out_of_range);
+    CHECK(refused(R"({"id":1,"op":"write_registers","address":1,"values":[]})", CommandSet::generic).kind ==
+          CommandErrorKind::invalid_field);
+    CHECK(refused(R"({"id":1,"op":"write_registers","address":1,"values":[65536]})", CommandSet::generic).kind ==
+          CommandErrorKind::out_of_range);
+}
+
+TEST_CASE("commands: what the parser lets through, the device's profile still checks (nothing sent)") {
+    fe::RegisterImage image;
+    const auto xeg = fe::make_profile(fe::DeviceType::hiwin_xeg, fe::ProfileOptions{});
+    // 70 mm is beyond every XEG stroke (64 mm at most): 0x03 before anything is sent.
+    const auto far = requests(R"({"id":1,"op":"move","position_mm":70,"speed_mm_s":10})", fm::CommandSet::xeg);
+    REQUIRE(far.size() == 1);
+    CHECK(xeg->validate(far[0], image) == fp::ExceptionCode::illegal_data_value);
+    const auto near = requests(R"({"id":1,"op":"move","position_mm":10,"speed_mm_s":10})", fm::CommandSet::xeg);
+    CHECK_FALSE(xeg->validate(near[0], image));
+    const auto excd = fe::make_profile(fe::DeviceType::excd203mb, fe::ProfileOptions{});
+    // Half of the abs pair: 0x02.
+    const auto half = requests(R"({"id":1,"op":"set_register","address":256,"value":1})", fm::CommandSet::excd);
+    CHECK(excd->validate(half[0], image) == fp::ExceptionCode::illegal_data_address);
+    for (const auto& r : requests(R"({"id":1,"op":"jog","direction":"reverse","mode":"continuous"})", fm::CommandSet::excd)) {
+        CHECK_FALSE(excd->validate(r, image));
+    }
+    const auto wtec = fe::make_profile(fe::DeviceType::wtec_rtu, fe::ProfileOptions{});
+    for (const auto& r : requests(R"({"id":1,"op":"grip","force_pct":50,"speed_pct":80})", fm::CommandSet::wtec)) {
+        CHECK_FALSE(wtec->validate(r, image));
+    }
+    CHECK(fm::command_ops(fm::CommandSet::generic) == std::vector<std::string_view>{"set_register", "write_registers"});
+}
