@@ -39,7 +39,11 @@ void AlarmTracker::notice(const engine::DeviceNotice& notice, engine::TimePoint 
 std::vector<engine::Alarm> AlarmTracker::wanted(const std::vector<engine::Alarm>& profile_alarms, bool online,
                                                 engine::TimePoint now) {
     std::vector<engine::Alarm> want = profile_alarms;
-    if (!online) {
+    if (!first_update_) {
+        first_update_ = now;
+    }
+    ever_online_ = ever_online_ || online;
+    if (!online && (ever_online_ || now - *first_update_ >= settings_.startup_grace)) {
         comm_lost_ = true;
         online_since_.reset();
     } else if (comm_lost_) {
@@ -106,6 +110,9 @@ std::optional<engine::TimePoint> AlarmTracker::next_deadline() const noexcept {
     };
     if (comm_lost_ && online_since_) {
         consider(*online_since_ + settings_.comm_clear_hold);
+    }
+    if (!comm_lost_ && !ever_online_ && first_update_) {
+        consider(*first_update_ + settings_.startup_grace);
     }
     if (notice_) {
         consider(notice_until_);

@@ -7,7 +7,9 @@
 ///  - communication loss: raised (`comm_loss`, critical) as soon as the device is
 ///    offline (the line already waited for `offline_after` consecutive timeouts),
 ///    cleared only once it has been online again for `comm_clear_hold`, so a device
-///    that flaps does not flood the topic;
+///    that flaps does not flood the topic. A device never seen online since the
+///    gateway started gets `startup_grace` first (the first poll, the upstream's
+///    first connection), so a start-up is not reported as a communication loss;
 ///  - device notices (XEG FC07 exception status after an exception 0x04): the device
 ///    says it once, so the alarm (`exception_status`, warning) stays active for
 ///    `notice_hold` after the last notice, then clears. A notice with code 0 ("no
@@ -25,6 +27,7 @@ namespace fieldbridge::northbound::mqtt {
 struct AlarmSettings {
     engine::Duration comm_clear_hold = std::chrono::seconds{5};
     engine::Duration notice_hold = std::chrono::seconds{60};
+    engine::Duration startup_grace = std::chrono::seconds{5};
 };
 
 inline constexpr const char* comm_loss_code = "comm_loss";
@@ -53,6 +56,8 @@ private:
     AlarmSettings settings_;
     std::vector<ActiveAlarm> active_;
     bool comm_lost_ = false;
+    bool ever_online_ = false;
+    std::optional<engine::TimePoint> first_update_;  ///< start of the startup grace
     std::optional<engine::TimePoint> online_since_;  ///< while comm_lost_ and online
     std::optional<engine::DeviceNotice> notice_;
     engine::TimePoint notice_until_{};

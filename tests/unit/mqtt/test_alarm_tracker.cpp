@@ -38,9 +38,28 @@ TEST_CASE("alarms: raised once, kept while present, cleared when gone") {
     CHECK(t.active().empty());
 }
 
+TEST_CASE("alarms: a device not yet online at start-up gets a grace before comm_loss") {
+    auto t = tracker();
+    const fe::TimePoint t0{};
+    CHECK(t.update({}, false, t0).empty());
+    CHECK(t.next_deadline() == t0 + 5s);
+    CHECK(t.update({}, false, t0 + 4s).empty());
+    auto events = t.update({}, false, t0 + 5s);
+    REQUIRE(events.size() == 1);
+    CHECK(events[0].alarm.code == fm::comm_loss_code);
+
+    // Online within the grace: never raised.
+    auto u = tracker();
+    CHECK(u.update({}, false, t0).empty());
+    CHECK(u.update({}, true, t0 + 1s).empty());
+    CHECK_FALSE(u.next_deadline());
+    CHECK(u.update({}, true, t0 + 10s).empty());
+}
+
 TEST_CASE("alarms: communication loss is raised at once and cleared only after the device stayed online") {
     auto t = tracker();
     const fe::TimePoint t0{};
+    CHECK(t.update({}, true, t0 - 1s).empty());
     auto events = t.update({}, false, t0);
     REQUIRE(events.size() == 1);
     CHECK(events[0].alarm.code == fm::comm_loss_code);
