@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "protocol/wtec_ascii_commands.hpp"
+#include "wtec_test_support.hpp"
 #include "vectors.hpp"
 
 namespace {
@@ -24,21 +25,9 @@ using fieldbridge::protocol::DecodeResult;
 using fieldbridge::protocol::DecodeStatus;
 namespace wtec = fieldbridge::protocol::wtec;
 
-ByteView bytes(std::string_view text) {
-    return {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()};
-}
-
-template <typename T>
-std::string describe(const DecodeResult<T>& r) {
-    switch (r.status) {
-        case DecodeStatus::need_more: return "need_more";
-        case DecodeStatus::complete: return "complete";
-        case DecodeStatus::malformed: break;
-    }
-    return "malformed " + std::string(to_string(r.error));
-}
-
-std::string malformed(DecodeError why) { return "malformed " + std::string(to_string(why)); }
+using wtec_test::bytes;
+using wtec_test::describe;
+using wtec_test::malformed;
 
 const wtec::HomingParams manual_homing{0xFC, 0x7530, 0x30D40, 0x3E8, 0x41, 1, 0xC8, 0x989680};
 const wtec::GripperParams manual_gripper{0x5C44, 0x3F, 0xFF, 0x0A, 1};

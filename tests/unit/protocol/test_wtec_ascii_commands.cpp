@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "protocol/wtec_ascii_commands.hpp"
+#include "wtec_test_support.hpp"
 
 namespace {
 
@@ -21,21 +22,9 @@ using fieldbridge::protocol::DecodeResult;
 using fieldbridge::protocol::DecodeStatus;
 namespace wtec = fieldbridge::protocol::wtec;
 
-ByteView bytes(std::string_view text) {
-    return {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()};
-}
-
-template <typename T>
-std::string describe(const DecodeResult<T>& r) {
-    switch (r.status) {
-        case DecodeStatus::need_more: return "need_more";
-        case DecodeStatus::complete: return "complete";
-        case DecodeStatus::malformed: break;
-    }
-    return "malformed " + std::string(to_string(r.error));
-}
-
-std::string malformed(DecodeError why) { return "malformed " + std::string(to_string(why)); }
+using wtec_test::bytes;
+using wtec_test::describe;
+using wtec_test::malformed;
 
 const wtec::HomingParams homing{0xFD, 0x12345678, 0x9ABCDEF0, 0x0000FFFF, 0x7F, 0xE, 0xC8, 0x989680};
 const wtec::GripperParams gripper{0xFFFFFFFF, 0x3F, 0xFF, 0x0A, 0x1};

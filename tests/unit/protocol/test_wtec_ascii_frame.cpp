@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "protocol/wtec_ascii_frame.hpp"
+#include "wtec_test_support.hpp"
 
 namespace {
 
@@ -19,21 +20,9 @@ using fieldbridge::protocol::DecodeResult;
 using fieldbridge::protocol::DecodeStatus;
 namespace wtec = fieldbridge::protocol::wtec;
 
-ByteView bytes(std::string_view text) {
-    return {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()};
-}
-
-template <typename T>
-std::string describe(const DecodeResult<T>& r) {
-    switch (r.status) {
-        case DecodeStatus::need_more: return "need_more";
-        case DecodeStatus::complete: return "complete";
-        case DecodeStatus::malformed: break;
-    }
-    return "malformed " + std::string(to_string(r.error));
-}
-
-std::string malformed(DecodeError why) { return "malformed " + std::string(to_string(why)); }
+using wtec_test::bytes;
+using wtec_test::describe;
+using wtec_test::malformed;
 
 const std::string crlf = "\r\n";
 // Frames from the manual whose CRC verifies (tests/vectors/vectors.yaml).
