@@ -1,0 +1,483 @@
+"""End-to-end harness: the real fieldbridge daemon in front of fieldbridge-sim (devices
+on pseudo-terminals with wire-time emulation, the R6 on loopback) and, when a test
+needs it, a private mosquitto broker. Clients are third-party: pymodbus (Debian's
+python3-pymodbus), mbpoll, mosquitto_sub / mosquitto_pub, raw sockets.
+
+Every process is started here and killed by its PID in tearDown; every wait is
+bounded; everything listens on 127.0.0.1 on ports the kernel picked free.
+
+argv: <test script> --gateway FIELDBRIDGE --sim FIELDBRIDGE_SIM [unittest options]."""
+
+import json
+import os
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+import simlib
+
+try:
+    from pymodbus.client import ModbusTcpClient
+    PYMODBUS_ERROR = None
+except ImportError as e:  # reported by the tests that need it, as a failure
+    ModbusTcpClient = None
+    PYMODBUS_ERROR = e
+
+GATEWAY = None  # path of the fieldbridge binary, from --gateway
+
+# Generous bounds for a loaded 2-core machine and sanitizer builds.
+START_TIMEOUT = 30.0
+STOP_TIMEOUT = 10.0
+IO_TIMEOUT = 5.0
+
+
+def main():
+    """unittest.main() after taking --gateway and --sim off the command line."""
+    global GATEWAY
+    argv = list(sys.argv)
+    for option in ("--gateway", "--sim"):
+        if option in argv:
+            i = argv.index(option)
+            value = argv[i + 1]
+            del argv[i:i + 2]
+            if option == "--gateway":
+                GATEWAY = value
+            else:
+                simlib.SIM = value
+    if not GATEWAY or not os.access(GATEWAY, os.X_OK):
+        sys.exit("give the gateway binary with --gateway PATH")
+    if not simlib.SIM or not os.access(simlib.SIM, os.X_OK):
+        sys.exit("give the simulator binary with --sim PATH")
+    unittest.main(argv=argv, verbosity=2)
+
+
+def free_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_port(port, timeout, alive=lambda: True):
+    """True once something accepts connections on 127.0.0.1:port."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and alive():
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+                return True
+        except OSError:
+            time.sleep(0.05)
+    return False
+
+
+def environment():
+    env = dict(os.environ)
+    for name in ("NOTIFY_SOCKET", "WATCHDOG_USEC", "WATCHDOG_PID", "LISTEN_FDS", "LISTEN_PID"):
+        env.pop(name, None)
+    env.setdefault("ASAN_OPTIONS", "abort_on_error=1:detect_leaks=1")
+    env.setdefault("UBSAN_OPTIONS", "halt_on_error=1:print_stacktrace=1")
+    return env
+
+
+# ---- Modbus TCP frames ------------------------------------------------------------
+
+def mbap(transaction, unit, pdu):
+    return struct.pack(">HHHB", transaction, 0, len(pdu) + 1, unit) + pdu
+
+
+def recv_exactly(sock, count):
+    data = b""
+    while len(data) < count:
+        chunk = sock.recv(count - len(data))
+        if not chunk:
+            return None
+        data += chunk
+    return data
+
+
+def read_frame(sock):
+    """(transaction, unit, pdu) of the next MBAP frame, None when the peer closed."""
+    header = recv_exactly(sock, 7)
+    if header is None:
+        return None
+    transaction, protocol, length, unit = struct.unpack(">HHHB", header)
+    assert protocol == 0, header.hex(" ")
+    pdu = recv_exactly(sock, length - 1)
+    if pdu is None:
+        return None
+    return transaction, unit, pdu
+
+
+def closed_by_server(sock, timeout=IO_TIMEOUT):
+    sock.settimeout(timeout)
+    try:
+        return sock.recv(1) == b""
+    except ConnectionResetError:
+        return True
+    except socket.timeout:
+        return False
+
+
+# ---- processes --------------------------------------------------------------------
+
+class Process:
+    """A child process whose stderr (and optionally stdout) lines are collected by a
+    thread, so tests wait for a line with a bound instead of sleeping."""
+
+    def __init__(self, name, command, log_path, stdout_lines=False, env=None):
+        self.name = name
+        self.log_path = log_path
+        self.log = open(log_path, "wb")
+        self.lines = []
+        self._condition = threading.Condition()
+        self.proc = subprocess.Popen(command, stdin=subprocess.DEVNULL,
+                                     stdout=subprocess.PIPE if stdout_lines else self.log,
+                                     stderr=self.log if stdout_lines else subprocess.PIPE,
+                                     env=env)
+        stream = self.proc.stdout if stdout_lines else self.proc.stderr
+        self._reader = threading.Thread(target=self._read, args=(stream,), daemon=True)
+        self._reader.start()
+
+    def _read(self, stream):
+        for raw in iter(stream.readline, b""):
+            line = raw.decode("utf-8", errors="replace").rstrip("\n")
+            with self._condition:
+                self.lines.append(line)
+                self._condition.notify_all()
+            if not isinstance(self, Subscriber):
+                self.log.write(raw)
+                self.log.flush()
+        with self._condition:
+            self.lines.append(None)
+            self._condition.notify_all()
+
+    @property
+    def pid(self):
+        return self.proc.pid
+
+    def running(self):
+        return self.proc.poll() is None
+
+    def text(self):
+        with self._condition:
+            return "\n".join(line for line in self.lines if line is not None)
+
+    def wait_line(self, predicate, timeout, start=0):
+        """Index and text of the first line from `start` on that satisfies predicate,
+        or None at the deadline or end of stream."""
+        def find():
+            for i in range(start, len(self.lines)):
+                line = self.lines[i]
+                if line is None:
+                    return (-1, None)
+                if predicate(line):
+                    return (i, line)
+            return None
+
+        with self._condition:
+            found = self._condition.wait_for(find, timeout)
+        if not found or found[1] is None:
+            return None
+        return found
+
+    def signal(self, sig):
+        if self.running():
+            os.kill(self.proc.pid, sig)
+
+    def wait_exit(self, timeout=STOP_TIMEOUT):
+        return self.proc.wait(timeout)
+
+    def kill(self):
+        if self.proc.poll() is None:
+            os.kill(self.proc.pid, signal.SIGKILL)
+            self.proc.wait(STOP_TIMEOUT)
+        self._reader.join(STOP_TIMEOUT)
+        for stream in (self.proc.stdout, self.proc.stderr):
+            if stream:
+                stream.close()
+        self.log.close()
+
+
+class Subscriber(Process):
+    """mosquitto_sub printing 'retained-flag topic payload' per message."""
+
+    def messages(self, topic, start=0):
+        with self._condition:
+            found = []
+            for line in self.lines[start:]:
+                if line is None:
+                    break
+                retained, got_topic, payload = line.split(" ", 2)
+                if got_topic == topic:
+                    found.append((retained == "1", payload))
+            return found
+
+    def wait_message(self, topic, predicate=lambda payload: True, timeout=IO_TIMEOUT, start=0):
+        """(retained, payload) of the first message on topic satisfying predicate."""
+        def match(line):
+            retained, got_topic, payload = line.split(" ", 2)
+            return got_topic == topic and predicate(payload)
+
+        found = self.wait_line(match, timeout, start)
+        if found is None:
+            return None
+        retained, _, payload = found[1].split(" ", 2)
+        return retained == "1", payload
+
+    def mark(self):
+        with self._condition:
+            return len(self.lines)
+
+
+def json_predicate(check):
+    def predicate(payload):
+        try:
+            return check(json.loads(payload))
+        except (ValueError, KeyError, TypeError):
+            return False
+    return predicate
+
+
+# ---- the test case ----------------------------------------------------------------
+
+# Timeouts are generous (300 ms reply, 2 s command deadline): the tests run beside
+# sanitizer builds on a loaded 2-core machine, and a write that times out is never
+# retried (spec section 3 rule 6).
+CELL_CONFIG = """\
+gateway:
+  id: e2e
+  log_level: info
+modbus_tcp:
+  listen: ["127.0.0.1:{tcp_port}"]
+  max_connections: {max_connections}
+  idle_timeout: 60s
+{rules}lines:
+  - name: line-a
+    port: {tmp}/line-a
+    baud: 115200
+    response_timeout: 300ms
+    broadcast_unit: 100
+    devices:
+      - {{name: gripper-1, type: hiwin-xeg, address: 2, unit_id: 1, allow_protected: true, command_ttl: 2s}}
+      - {{name: stepper-1, type: excd203mb, address: 3, unit_id: 2, command_ttl: 2s}}
+      - {{name: gripper-2, type: wtec-ascii, address: 5, unit_id: 3, stroke: 20000, command_ttl: 2s}}
+{extra_devices_a}  - name: line-b
+    port: {tmp}/line-b
+    baud: 115200
+    response_timeout: 300ms
+    devices:
+      - {{name: gripper-3, type: wtec-rtu, address: 1, unit_id: 4, command_ttl: 2s}}
+{extra_devices_b}{extra_lines}{upstreams}{mqtt}"""
+
+UPSTREAM_CONFIG = """\
+upstreams:
+  - name: r6
+    host: 127.0.0.1
+    port: {r6_port}
+    units:
+      - {{unit_id: 50, upstream_unit: 1, name: r6}}
+"""
+
+MQTT_CONFIG = """\
+mqtt:
+  uri: tcp://127.0.0.1:{mqtt_port}
+  qos: 1
+  keep_alive: 2s
+  heartbeat: 30s
+  min_interval: 100ms
+  diag_period: 60s
+  reconnect_backoff: {{initial: 200ms, max: 1s}}
+"""
+
+
+class CellTestCase(unittest.TestCase):
+    """A simulated cell: fieldbridge-sim with line-a (XEG @2 unit 1, EXCD203MB @3 unit 2,
+    WTEC ASCII @5 unit 3, broadcast unit 100) and line-b (WTEC RTU @1 unit 4), the
+    gateway in front of it, optionally the R6 (unit 50) and a broker."""
+
+    def setUp(self):
+        if PYMODBUS_ERROR is not None:
+            self.fail("python3-pymodbus is needed: %s" % PYMODBUS_ERROR)
+        self._tmp = tempfile.TemporaryDirectory(prefix="fb-e2e-")
+        self.tmp = self._tmp.name
+        self.processes = []
+        self.sim = None
+        self.gateway = None
+        self.broker = None
+        self.clients = []
+
+    def tearDown(self):
+        for client in self.clients:
+            client.close()
+        result = getattr(getattr(self, "_outcome", None), "result", None)
+        failed = result is not None and any(
+            test is self for test, _ in list(result.failures) + list(result.errors))
+        # The gateway and the simulator still running are stopped with SIGTERM and must
+        # exit 0, so that a sanitizer build's leak and shutdown checks count.
+        unclean = []
+        for process in reversed(self.processes):
+            if process is self.gateway and process.running():
+                process.signal(signal.SIGTERM)
+                try:
+                    code = process.wait_exit()
+                    if code != 0:
+                        unclean.append("fieldbridge exited with %d after SIGTERM" % code)
+                except subprocess.TimeoutExpired:
+                    unclean.append("fieldbridge ignored SIGTERM for %.0f s" % STOP_TIMEOUT)
+            process.kill()
+            if failed or unclean:
+                sys.stderr.write("---- %s log ----\n%s\n" % (process.name, _read(process.log_path)))
+        if self.sim is not None:
+            if self.sim.proc.poll() is None:
+                try:
+                    code = self.sim.terminate()
+                    if code != 0:
+                        unclean.append("fieldbridge-sim exited with %d after SIGTERM" % code)
+                except AssertionError as e:
+                    unclean.append(str(e))
+            if failed or unclean:
+                sys.stderr.write("---- simulator log ----\n" + self.sim.log_text())
+            self.sim.close()
+        self._tmp.cleanup()
+        if unclean:
+            raise AssertionError("; ".join(unclean))
+
+    def path(self, name):
+        return os.path.join(self.tmp, name)
+
+    # -- starting --------------------------------------------------------------------
+
+    def start_cell(self, r6=False, mqtt=False, extra_devices_a="", extra_devices_b="", extra_lines="",
+                   rules="", max_connections=64, sim_line_b="wtec-rtu@1", sim_extra=(), before_gateway=None):
+        """Simulator, broker (mqtt=True), before_gateway() if given, gateway; returns
+        when the gateway is ready."""
+        self.tcp_port = free_port()
+        self.r6_port = free_port() if r6 else None
+        args = ["--bus", self.path("line-a") + ":hiwin-xeg@2,excd203mb@3,wtec-ascii@5",
+                "--bus", self.path("line-b") + ":" + sim_line_b,
+                "--control", self.path("sim.sock"), "--wire-time", "--baud", "115200"]
+        if r6:
+            args += ["--r6", "127.0.0.1:%d" % self.r6_port]
+        self.sim = simlib.Sim(args + list(sim_extra), self.tmp)
+        if mqtt:
+            self.mqtt_port = free_port()
+            self.start_broker()
+        if before_gateway is not None:
+            before_gateway()
+        config = CELL_CONFIG.format(
+            tcp_port=self.tcp_port, tmp=self.tmp, max_connections=max_connections,
+            extra_devices_a=extra_devices_a, extra_devices_b=extra_devices_b, extra_lines=extra_lines,
+            rules=rules,
+            upstreams=UPSTREAM_CONFIG.format(r6_port=self.r6_port) if r6 else "",
+            mqtt=MQTT_CONFIG.format(mqtt_port=self.mqtt_port) if mqtt else "")
+        self.config_path = self.path("gateway.yaml")
+        with open(self.config_path, "w", encoding="utf-8") as f:
+            f.write(config)
+        self.start_gateway()
+
+    def start_gateway(self):
+        self.gateway = Process("fieldbridge", [GATEWAY, "--config", self.config_path],
+                               self.path("gateway.log"), env=environment())
+        self.processes.append(self.gateway)
+        if self.gateway.wait_line(lambda line: "ready:" in line, START_TIMEOUT) is None:
+            self.fail("fieldbridge did not log 'ready:' within %.0f s:\n%s"
+                      % (START_TIMEOUT, self.gateway.text()))
+
+    def start_broker(self):
+        conf = self.path("mosquitto.conf")
+        with open(conf, "w", encoding="utf-8") as f:
+            f.write("listener %d 127.0.0.1\nallow_anonymous true\npersistence false\n" % self.mqtt_port)
+        self.broker = Process("mosquitto", ["mosquitto", "-c", conf], self.path("mosquitto.log"))
+        self.processes.append(self.broker)
+        if not wait_port(self.mqtt_port, START_TIMEOUT, self.broker.running):
+            self.fail("mosquitto did not listen on %d:\n%s" % (self.mqtt_port, _read(self.broker.log_path)))
+
+    def stop_broker(self):
+        self.broker.signal(signal.SIGTERM)
+        self.broker.wait_exit()
+        self.processes.remove(self.broker)
+        self.broker.kill()
+
+    def subscribe(self, *topics):
+        command = ["mosquitto_sub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
+                   "-F", "%r %t %p"]
+        for topic in topics:
+            command += ["-t", topic]
+        sub = Subscriber("mosquitto_sub", command, self.path("sub-%d.log" % len(self.processes)),
+                         stdout_lines=True)
+        self.processes.append(sub)
+        # mosquitto_sub prints nothing when subscribed: give it a moment, bounded, by
+        # waiting for the broker to count it (a retained message would also show it).
+        time.sleep(0.3)
+        return sub
+
+    def publish(self, topic, payload, retain=False):
+        command = ["mosquitto_pub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
+                   "-t", topic, "-m", payload]
+        if retain:
+            command.append("-r")
+        done = subprocess.run(command, capture_output=True, text=True, timeout=IO_TIMEOUT)
+        self.assertEqual(done.returncode, 0, done.stderr)
+
+    # -- clients ---------------------------------------------------------------------
+
+    def client(self):
+        client = ModbusTcpClient("127.0.0.1", port=self.tcp_port, timeout=IO_TIMEOUT, retries=0)
+        self.assertTrue(client.connect(), "pymodbus cannot connect to the gateway")
+        self.clients.append(client)
+        return client
+
+    def raw(self):
+        sock = socket.create_connection(("127.0.0.1", self.tcp_port), timeout=IO_TIMEOUT)
+        self.clients.append(sock)
+        return sock
+
+    def control(self, line):
+        reply = simlib.control(self.path("sim.sock"), line)
+        self.assertTrue(reply.startswith("ok"), "%s -> %s" % (line, reply))
+        return reply
+
+    def sim_stats(self):
+        return json.loads(self.control("stats")[3:])
+
+    def device_frames(self, bus, address):
+        return self.sim_stats()["buses"][bus]["devices"][str(address)]["frames"]
+
+    # -- assertions ------------------------------------------------------------------
+
+    def assert_ok(self, reply):
+        self.assertFalse(reply.isError(), reply)
+        return reply
+
+    def assert_exception(self, reply, code):
+        self.assertTrue(reply.isError(), "expected exception 0x%02X, got %r" % (code, reply))
+        self.assertEqual(getattr(reply, "exception_code", None), code, reply)
+
+    def read_holding(self, client, address, count, unit):
+        return self.assert_ok(client.read_holding_registers(address, count, slave=unit)).registers
+
+    def read_input(self, client, address, count, unit):
+        return self.assert_ok(client.read_input_registers(address, count, slave=unit)).registers
+
+    def wait_value(self, read, expected, timeout, what):
+        """Polls read() until it returns expected (bounded); returns the last value."""
+        last = [None]
+
+        def check():
+            last[0] = read()
+            return last[0] == expected
+        simlib.wait_until(check, timeout, interval=0.05)
+        self.assertEqual(last[0], expected, "%s never became %r" % (what, expected))
+
+
+def _read(path):
+    try:
+        with open(path, "rb") as f:
+            return f.read().decode(errors="replace")
+    except OSError:
+        return ""
