@@ -1,0 +1,261 @@
+// Benchmark of the line engine (issue 3, spec section 9): the real engine::Engine,
+// built from YAML by the real loader, against `fieldbridge-sim --wire-time` on a
+// pseudo-terminal (one HIWIN XEG at 115200 bit/s, 1 ms device turnaround).
+//
+//   fb_bench_line [seconds=5] [writes=200]
+//
+//   a. line utilisation: 16 on-demand FC04 0x0300 x2 reads kept outstanding
+//      (max_age 0), completed transactions/s against 1 / T_line;
+//   b. command latency: the same saturating reads plus one FC16 write every
+//      30-50 ms (random phase), submit -> answer latency against the priority ideal;
+//   c. CPU per serial transaction: getrusage(RUSAGE_SELF) over run (a).
+//
+// The simulator binary is named by FIELDBRIDGE_SIM (run-benchmarks sets it); it is a
+// separate process, so the CPU figure is the gateway side alone (engine, scheduler,
+// line I/O and this load generator's callbacks). Not a test: it prints figures and
+// asserts nothing.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <asio/steady_timer.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "engine/line_timing.hpp"
+#include "engine_harness.hpp"
+#include "sim_process.hpp"
+
+namespace {
+
+using namespace fieldbridge;
+using integration::EngineHarness;
+using integration::SimProcess;
+using Clock = std::chrono::steady_clock;
+using std::chrono::duration;
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+
+constexpr unsigned outstanding_reads = 16;
+constexpr std::uint16_t status_address = 0x0300;  // position + status, input registers
+constexpr std::uint16_t speed_address = 0x0631;   // "move: speed": a parameter, moves nothing alone
+// RTU frame sizes: FC04 x2 request 8, reply 3 + 4 + 2 = 9; FC16 x1 request 11, reply 8.
+constexpr std::size_t read_request_bytes = 8;
+constexpr std::size_t read_reply_bytes = 9;
+constexpr std::size_t write_request_bytes = 11;
+constexpr std::size_t write_reply_bytes = 8;
+
+double cpu_seconds() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const auto to_seconds = [](const timeval& tv) {
+        return static_cast<double>(tv.tv_sec) + static_cast<double>(tv.tv_usec) / 1e6;
+    };
+    return to_seconds(usage.ru_utime) + to_seconds(usage.ru_stime);
+}
+
+double ms(Clock::duration d) { return duration<double, std::milli>(d).count(); }
+
+double percentile(std::vector<double> values, double p) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const auto rank = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1) + 0.5);
+    return values[std::min(rank, values.size() - 1)];
+}
+
+/// Keeps a fixed number of status reads queued on one device: each answer submits the
+/// next, so the line never runs dry.
+class ReadLoad {
+public:
+    explicit ReadLoad(engine::DeviceAgent& agent) : agent_(agent) {}
+    void start(unsigned count) {
+        for (unsigned i = 0; i < count; ++i) submit();
+    }
+    void stop() { stopping_ = true; }
+    [[nodiscard]] std::uint64_t completed() const noexcept { return completed_; }
+    [[nodiscard]] std::uint64_t failed() const noexcept { return failed_; }
+
+private:
+    void submit() {
+        agent_.request(integration::read_input(status_address, 2), [this](const protocol::Response& response) {
+            if (integration::registers_of(response).size() == 2) {
+                ++completed_;
+            } else {
+                ++failed_;
+            }
+            if (!stopping_) submit();
+        });
+    }
+
+    engine::DeviceAgent& agent_;
+    bool stopping_ = false;
+    std::uint64_t completed_ = 0;
+    std::uint64_t failed_ = 0;
+};
+
+std::string engine_yaml(const std::string& port) {
+    // Polls slowed down so that (a) measures the on-demand reads alone; max_age 0: every
+    // read goes to the line; a queue long enough for the readers and the writes.
+    return fmt::format(R"(
+gateway: {{ id: bench-line }}
+lines:
+  - name: line-a
+    port: {}
+    baud: 115200
+    turnaround: 0ms
+    devices:
+      - name: xeg
+        type: hiwin-xeg
+        address: 2
+        unit_id: 1
+        max_age: 0ms
+        queue_limit: 64
+        command_ttl: 1s
+        poll: {{ fast: 60min, slow: 60min, motion: 60min }}
+)",
+                       port);
+}
+
+int run(double run_seconds, int write_count) {
+    const engine::LineTiming timing(engine::CharacterFormat{115200, 8, false, 1});
+    const auto turnaround = milliseconds{1};
+    const double t_read = duration<double, std::milli>(
+                              timing.transaction_time(read_request_bytes, read_reply_bytes, turnaround))
+                              .count();
+    const double t_write = duration<double, std::milli>(
+                               timing.transaction_time(write_request_bytes, write_reply_bytes, turnaround))
+                               .count();
+    const double limit_tps = 1000.0 / t_read;
+
+    SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--wire-time", "--baud", "115200", "--turnaround", "1ms"});
+    EngineHarness h(engine_yaml(sim.path("line-a")));
+    h.start();
+    auto& xeg = h.device("xeg");
+    if (!h.run_until([&] { return xeg.online(); }, seconds{5})) {
+        std::fprintf(stderr, "fb_bench_line: the XEG did not come online within 5 s\n%s\n", sim.log_text().c_str());
+        return 1;
+    }
+
+    // ---- a + c: utilisation and CPU ----------------------------------------------
+    ReadLoad reads(xeg);
+    reads.start(outstanding_reads);
+    h.run_for(milliseconds{500});  // warm-up
+    const auto bus0 = sim.stats()["buses"]["line-a"];
+    const std::uint64_t done0 = reads.completed();
+    const double cpu0 = cpu_seconds();
+    const auto t0 = Clock::now();
+    h.run_for(std::chrono::duration_cast<engine::Duration>(duration<double>(run_seconds)));
+    const auto t1 = Clock::now();
+    const double cpu1 = cpu_seconds();
+    const std::uint64_t done1 = reads.completed();
+    const auto bus1 = sim.stats()["buses"]["line-a"];
+
+    const double elapsed = duration<double>(t1 - t0).count();
+    const auto transactions = static_cast<double>(done1 - done0);
+    const double tps = transactions / elapsed;
+    const double cpu_us = (cpu1 - cpu0) * 1e6 / transactions;
+    const auto counter = [](const nlohmann::json& bus, const char* name) { return bus.value(name, std::uint64_t{0}); };
+
+    std::printf("== fb_bench_line (a) line utilisation: 16 on-demand FC04 0x0300 x2 reads outstanding ==\n");
+    std::printf("T_line (8 + 9 bytes, 115200 8N1, 1 ms turnaround) = %.3f ms -> limit %.1f tx/s\n", t_read, limit_tps);
+    std::printf("completed %.0f reads in %.3f s = %.1f tx/s, ratio %.3f (target >= 0.95); failed %llu\n", transactions,
+                elapsed, tps, tps / limit_tps, static_cast<unsigned long long>(reads.failed()));
+    std::printf("simulator: %llu requests, %llu replies in the window; gap_violations total %llu (target 0), "
+                "min_silence_us %s, collisions %llu, utilization %s\n",
+                static_cast<unsigned long long>(counter(bus1, "requests") - counter(bus0, "requests")),
+                static_cast<unsigned long long>(counter(bus1, "replies") - counter(bus0, "replies")),
+                static_cast<unsigned long long>(counter(bus1, "gap_violations")),
+                bus1.contains("min_silence_us") ? bus1["min_silence_us"].dump().c_str() : "?",
+                static_cast<unsigned long long>(counter(bus1, "collisions")),
+                bus1.contains("utilization") ? bus1["utilization"].dump().c_str() : "?");
+    // Where the time between transactions goes: how late the simulator's replies left
+    // (its own scheduling), against the silence the master actually kept.
+    const double per_tx_ms = elapsed * 1000.0 / transactions;
+    std::printf("mean line time per transaction %.3f ms = T_line + %.3f ms; simulator reply lateness %s\n",
+                per_tx_ms, per_tx_ms - t_read, bus1.contains("timing") ? bus1["timing"].dump().c_str() : "?");
+    std::printf("== fb_bench_line (c) CPU per serial transaction ==\n");
+    std::printf("process CPU (user+sys) %.3f s over %.0f transactions = %.1f us/transaction (target <= 50)\n",
+                cpu1 - cpu0, transactions, cpu_us);
+
+    // ---- b: command latency under saturating reads --------------------------------
+    std::vector<double> latencies;
+    int write_failures = 0;
+    int submitted = 0;
+    std::mt19937 random(20261124);
+    std::uniform_int_distribution<int> gap_us(30'000, 50'000);
+    asio::steady_timer timer(h.io());
+    std::function<void()> schedule = [&] {
+        timer.expires_after(std::chrono::microseconds{gap_us(random)});
+        timer.async_wait([&](const std::error_code& ec) {
+            if (ec || submitted >= write_count) return;
+            const auto value = static_cast<std::uint16_t>(1000 + (submitted % 2));
+            ++submitted;
+            const auto sent = Clock::now();
+            xeg.request(protocol::WriteMultipleRegistersRequest{speed_address, {value}},
+                        [&, sent](const protocol::Response& response) {
+                            if (std::holds_alternative<protocol::WriteMultipleResponse>(response)) {
+                                latencies.push_back(ms(Clock::now() - sent));
+                            } else {
+                                ++write_failures;
+                            }
+                        });
+            schedule();
+        });
+    };
+    const std::uint64_t b_done0 = reads.completed();
+    const auto b0 = Clock::now();
+    schedule();
+    h.run_until([&] { return static_cast<int>(latencies.size()) + write_failures >= write_count; },
+                seconds{write_count / 10 + 10}, milliseconds{50});
+    const auto b1 = Clock::now();
+    const double b_tps = static_cast<double>(reads.completed() - b_done0) / duration<double>(b1 - b0).count();
+    timer.cancel();
+    reads.stop();
+    h.run_for(milliseconds{200});
+
+    const double ideal_p50 = t_write + t_read / 2.0;
+    const double ideal_max = t_write + t_read;
+    const double p50 = percentile(latencies, 0.50);
+    const double p99 = percentile(latencies, 0.99);
+    const double max = latencies.empty() ? 0.0 : *std::max_element(latencies.begin(), latencies.end());
+    std::printf("== fb_bench_line (b) write latency with 16 reads outstanding ==\n");
+    std::printf("write FC16 x1 (11 + 8 bytes): T_write = %.3f ms; priority ideal p50 = T_write + T_read/2 = %.3f ms, "
+                "max = T_write + T_read = %.3f ms\n",
+                t_write, ideal_p50, ideal_max);
+    std::printf("%zu writes ok, %d failed; reads meanwhile %.1f tx/s\n", latencies.size(), write_failures, b_tps);
+    std::printf("latency p50 %.3f ms, p99 %.3f ms, max %.3f ms\n", p50, p99, max);
+    std::printf("ratios to the recomputed ideal: p50 %.2f (target <= 1.2), max %.2f (target <= 1.5)\n",
+                p50 / ideal_p50, max / ideal_max);
+    std::printf("ratios to the spec's figures (4.67 / 6.21 ms): p50 %.2f, max %.2f\n", p50 / 4.67, max / 6.21);
+    const auto bus2 = sim.stats()["buses"]["line-a"];
+    std::printf("simulator gap_violations after (b): %llu\n",
+                static_cast<unsigned long long>(counter(bus2, "gap_violations")));
+
+    h.stop();
+    sim.terminate();
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        const double seconds_arg = argc > 1 ? std::atof(argv[1]) : 5.0;
+        const int writes_arg = argc > 2 ? std::atoi(argv[2]) : 200;
+        if (seconds_arg <= 0.0 || writes_arg <= 0) {
+            std::fprintf(stderr, "usage: fb_bench_line [seconds>0] [writes>0]\n");
+            return 2;
+        }
+        return run(seconds_arg, writes_arg);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "fb_bench_line: %s\n", e.what());
+        return 1;
+    }
+}

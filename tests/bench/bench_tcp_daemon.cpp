@@ -1,0 +1,327 @@
+// Benchmark of the whole gateway over Modbus TCP (issue 4, spec section 9): the real
+// `fieldbridge` daemon on a generated configuration, two lines on `fieldbridge-sim
+// --wire-time` pseudo-terminals (115200 bit/s, 1 ms device turnaround), one HIWIN XEG
+// on each, and load-generating client threads in this process.
+//
+//   FIELDBRIDGE_SIM=<fieldbridge-sim> fb_bench_tcp_daemon <fieldbridge> [seconds=5]
+//
+//   1. cache-served reads: 32 clients (blocking sockets, one request outstanding each)
+//      read FC04 0x0300 x2 from unit 1 (line-a, max_age 10s, polled every 100 ms):
+//      reads/s, p50/p99 latency, and the serial requests the simulator saw during the
+//      load against an idle window of the same length before it (polls only);
+//   2. TCP -> line throughput: 16 clients read the same registers from unit 2 (line-b,
+//      max_age 0: every read goes to the line): transactions/s against 1 / T_line.
+//
+// Clients and daemon share the machine's cores: the figures include that contention.
+// Not a test: it prints figures and asserts nothing.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "daemon_process.hpp"
+#include "engine/line_timing.hpp"
+#include "sim_process.hpp"
+
+namespace {
+
+using namespace fieldbridge;
+using Clock = std::chrono::steady_clock;
+using std::chrono::duration;
+using std::chrono::milliseconds;
+
+constexpr std::uint16_t status_address = 0x0300;
+
+/// A loopback port free at the moment of asking (the daemon binds it right after).
+std::uint16_t free_port() {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+        close(fd);
+        throw std::runtime_error("cannot bind a loopback port to find a free one");
+    }
+    socklen_t length = sizeof address;
+    getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+    close(fd);
+    return ntohs(address.sin_port);
+}
+
+struct ClientResult {
+    std::vector<double> latency_us;  ///< requests sent inside the window
+    std::uint64_t errors = 0;        ///< exceptions, short reads, timeouts
+    std::string failure;             ///< why the client stopped early, if it did
+};
+
+bool read_exactly(int fd, std::uint8_t* data, std::size_t size) {
+    std::size_t got = 0;
+    while (got < size) {
+        const auto n = recv(fd, data + got, size - got, 0);
+        if (n <= 0) return false;
+        got += static_cast<std::size_t>(n);
+    }
+    return true;
+}
+
+/// One Modbus TCP client: FC04 @p address x2 to @p unit, one request at a time, until
+/// @p stop; latencies recorded for requests sent in [window_start, window_end).
+void run_client(std::uint16_t port, std::uint8_t unit, const std::atomic<bool>& stop, Clock::time_point window_start,
+                Clock::time_point window_end, ClientResult& result) {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    const int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    const timeval timeout{3, 0};  // bounded: a lost answer ends the client, not the run
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(port);
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+        result.failure = "connect failed";
+        close(fd);
+        return;
+    }
+    result.latency_us.reserve(400'000);
+    std::uint16_t transaction = 0;
+    while (!stop.load(std::memory_order_relaxed)) {
+        ++transaction;
+        const std::array<std::uint8_t, 12> request{
+            static_cast<std::uint8_t>(transaction >> 8), static_cast<std::uint8_t>(transaction & 0xFF), 0, 0, 0, 6, unit,
+            0x04, static_cast<std::uint8_t>(status_address >> 8), static_cast<std::uint8_t>(status_address & 0xFF), 0,
+            2};
+        const auto sent = Clock::now();
+        if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) {
+            result.failure = "send failed";
+            break;
+        }
+        std::array<std::uint8_t, 260> reply{};
+        if (!read_exactly(fd, reply.data(), 7)) {
+            result.failure = "no answer within 3 s";
+            break;
+        }
+        const std::size_t rest = static_cast<std::size_t>((reply[4] << 8) | reply[5]) - 1;
+        if (rest == 0 || rest > 253 || !read_exactly(fd, reply.data() + 7, rest)) {
+            result.failure = "bad MBAP length";
+            break;
+        }
+        const auto answered = Clock::now();
+        const bool ok = reply[7] == 0x04 && rest == 6;
+        if (!ok) ++result.errors;
+        if (ok && sent >= window_start && sent < window_end) {
+            result.latency_us.push_back(duration<double, std::micro>(answered - sent).count());
+        }
+    }
+    close(fd);
+}
+
+struct LoadFigures {
+    double seconds = 0.0;
+    std::uint64_t reads = 0;
+    std::uint64_t errors = 0;
+    double p50_us = 0.0;
+    double p99_us = 0.0;
+    double max_us = 0.0;
+    std::string failures;
+};
+
+double percentile(const std::vector<double>& sorted, double p) {
+    if (sorted.empty()) return 0.0;
+    const auto rank = static_cast<std::size_t>(p * static_cast<double>(sorted.size() - 1) + 0.5);
+    return sorted[std::min(rank, sorted.size() - 1)];
+}
+
+/// Runs @p clients clients for warm-up + @p seconds; @p in_window runs on this thread
+/// at the window's start and end (simulator counters, daemon CPU).
+template <typename Probe>
+LoadFigures run_load(std::uint16_t port, std::uint8_t unit, unsigned clients, double seconds, Probe&& in_window) {
+    std::atomic<bool> stop{false};
+    const auto window_start = Clock::now() + milliseconds{500};
+    const auto window_end = window_start + std::chrono::duration_cast<Clock::duration>(duration<double>(seconds));
+    std::vector<ClientResult> results(clients);
+    std::vector<std::thread> threads;
+    for (unsigned i = 0; i < clients; ++i) {
+        threads.emplace_back(run_client, port, unit, std::cref(stop), window_start, window_end, std::ref(results[i]));
+    }
+    std::this_thread::sleep_until(window_start);
+    in_window(true);
+    std::this_thread::sleep_until(window_end);
+    in_window(false);
+    stop = true;
+    for (auto& thread : threads) thread.join();
+
+    LoadFigures figures;
+    figures.seconds = seconds;
+    std::vector<double> all;
+    for (const auto& result : results) {
+        all.insert(all.end(), result.latency_us.begin(), result.latency_us.end());
+        figures.errors += result.errors;
+        if (!result.failure.empty()) figures.failures += result.failure + "; ";
+    }
+    std::sort(all.begin(), all.end());
+    figures.reads = all.size();
+    figures.p50_us = percentile(all, 0.50);
+    figures.p99_us = percentile(all, 0.99);
+    figures.max_us = all.empty() ? 0.0 : all.back();
+    return figures;
+}
+
+std::string daemon_yaml(std::uint16_t port, const std::string& line_a, const std::string& line_b) {
+    return fmt::format(R"(# Generated by fb_bench_tcp_daemon.
+gateway: {{ id: bench, log_level: info }}
+modbus_tcp:
+  listen: ["127.0.0.1:{}"]
+  max_connections: 64
+lines:
+  - name: line-a          # cache-served reads: polled, answered from the image
+    port: {}
+    baud: 115200
+    turnaround: 0ms
+    devices:
+      - name: xeg-cached
+        type: hiwin-xeg
+        address: 2
+        unit_id: 1
+        max_age: 10s
+        poll: {{ fast: 100ms, slow: 1s }}
+  - name: line-b          # TCP -> line: every read goes to the device
+    port: {}
+    baud: 115200
+    turnaround: 0ms
+    devices:
+      - name: xeg-direct
+        type: hiwin-xeg
+        address: 2
+        unit_id: 2
+        max_age: 0ms
+        queue_limit: 64
+        poll: {{ fast: 60min, slow: 60min, motion: 60min }}
+)",
+                       port, line_a, line_b);
+}
+
+std::uint64_t bus_counter(const integration::SimProcess& sim, const char* bus, const char* name) {
+    return sim.bus_counter(bus, name);
+}
+
+int run(const std::string& daemon_binary, double seconds) {
+    integration::SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-b:hiwin-xeg@2",
+                                 "--wire-time", "--baud", "115200", "--turnaround", "1ms"});
+    const std::uint16_t port = free_port();
+    const auto config_path = sim.dir() / "bench.yaml";
+    std::ofstream(config_path) << daemon_yaml(port, sim.path("line-a"), sim.path("line-b"));
+    bench::DaemonProcess daemon(daemon_binary, config_path, sim.dir() / "fieldbridge.log");
+
+    // Let the polls fill line-a's image, then measure an idle window: the polls alone.
+    std::this_thread::sleep_for(milliseconds{1500});
+    const auto idle_requests0 = bus_counter(sim, "line-a", "requests");
+    const double idle_cpu0 = daemon.cpu_seconds();
+    const auto idle0 = Clock::now();
+    std::this_thread::sleep_for(duration<double>(seconds));
+    const double idle_elapsed = duration<double>(Clock::now() - idle0).count();
+    const double idle_cpu = daemon.cpu_seconds() - idle_cpu0;
+    const auto idle_requests = bus_counter(sim, "line-a", "requests") - idle_requests0;
+
+    // ---- 1: cache-served reads ----------------------------------------------------
+    std::uint64_t a_requests0 = 0;
+    std::uint64_t a_requests1 = 0;
+    double cached_cpu0 = 0.0;
+    double cached_cpu1 = 0.0;
+    const auto cached = run_load(port, 1, 32, seconds, [&](bool start) {
+        (start ? a_requests0 : a_requests1) = bus_counter(sim, "line-a", "requests");
+        (start ? cached_cpu0 : cached_cpu1) = daemon.cpu_seconds();
+    });
+    const double cached_rate = static_cast<double>(cached.reads) / cached.seconds;
+    const auto load_requests = a_requests1 - a_requests0;
+    const double idle_rate = static_cast<double>(idle_requests) / idle_elapsed;
+
+    std::printf("== fb_bench_tcp_daemon (1) cache-served reads: 32 clients, FC04 0x0300 x2, unit 1 (max_age 10s) ==\n");
+    std::printf("%llu reads in %.1f s = %.0f reads/s (target >= 50000); errors %llu%s%s\n",
+                static_cast<unsigned long long>(cached.reads), cached.seconds, cached_rate,
+                static_cast<unsigned long long>(cached.errors), cached.failures.empty() ? "" : "; client failures: ",
+                cached.failures.c_str());
+    std::printf("latency p50 %.0f us, p99 %.0f us (target < 1000), max %.0f us\n", cached.p50_us, cached.p99_us,
+                cached.max_us);
+    std::printf("serial requests on line-a: %llu during the load (%.1f/s) vs %llu in the idle window before "
+                "(%.1f/s, polls only): %+.1f/s caused by the reads (target 0)\n",
+                static_cast<unsigned long long>(load_requests),
+                static_cast<double>(load_requests) / cached.seconds, static_cast<unsigned long long>(idle_requests),
+                idle_rate, static_cast<double>(load_requests) / cached.seconds - idle_rate);
+    std::printf("daemon CPU during the load: %.2f s of %.1f s (%.0f%% of one core; the clients use the rest)\n",
+                cached_cpu1 - cached_cpu0, cached.seconds, 100.0 * (cached_cpu1 - cached_cpu0) / cached.seconds);
+    std::printf("daemon idle CPU (two lines, one polled at 100 ms / 1 s): %.2f%% of one core; RSS %ld KiB\n",
+                100.0 * idle_cpu / idle_elapsed, daemon.rss_kib());
+
+    // ---- 2: TCP -> line throughput ------------------------------------------------
+    const engine::LineTiming timing(engine::CharacterFormat{115200, 8, false, 1});
+    const double t_line =
+        duration<double, std::milli>(timing.transaction_time(8, 9, milliseconds{1})).count();
+    const double limit = 1000.0 / t_line;
+    std::uint64_t b_requests0 = 0;
+    std::uint64_t b_requests1 = 0;
+    double direct_cpu0 = 0.0;
+    double direct_cpu1 = 0.0;
+    const auto direct = run_load(port, 2, 16, seconds, [&](bool start) {
+        (start ? b_requests0 : b_requests1) = bus_counter(sim, "line-b", "requests");
+        (start ? direct_cpu0 : direct_cpu1) = daemon.cpu_seconds();
+    });
+    const double direct_rate = static_cast<double>(direct.reads) / direct.seconds;
+    const auto b_requests = b_requests1 - b_requests0;
+    std::printf("== fb_bench_tcp_daemon (2) TCP -> line: 16 clients, FC04 0x0300 x2, unit 2 (max_age 0) ==\n");
+    std::printf("T_line = %.3f ms -> limit %.1f tx/s\n", t_line, limit);
+    std::printf("%llu reads answered in %.1f s = %.1f tx/s, ratio %.3f (target >= 0.95); errors %llu%s%s\n",
+                static_cast<unsigned long long>(direct.reads), direct.seconds, direct_rate, direct_rate / limit,
+                static_cast<unsigned long long>(direct.errors), direct.failures.empty() ? "" : "; client failures: ",
+                direct.failures.c_str());
+    std::printf("simulator line-b requests in the window: %llu = %.1f/s, ratio %.3f\n",
+                static_cast<unsigned long long>(b_requests), static_cast<double>(b_requests) / direct.seconds,
+                static_cast<double>(b_requests) / direct.seconds / limit);
+    std::printf("latency p50 %.2f ms, p99 %.2f ms, max %.2f ms (16 clients queued on one line: about 16 x T_line)\n",
+                direct.p50_us / 1000.0, direct.p99_us / 1000.0, direct.max_us / 1000.0);
+    std::printf("daemon CPU per serial transaction (TCP + engine): %.1f us\n",
+                b_requests == 0 ? 0.0 : (direct_cpu1 - direct_cpu0) * 1e6 / static_cast<double>(b_requests));
+    std::printf("gap_violations: line-a %llu, line-b %llu (target 0)\n",
+                static_cast<unsigned long long>(bus_counter(sim, "line-a", "gap_violations")),
+                static_cast<unsigned long long>(bus_counter(sim, "line-b", "gap_violations")));
+
+    const int daemon_status = daemon.terminate();
+    if (daemon_status != 0) std::fprintf(stderr, "fieldbridge exit status %d; log:\n%s\n", daemon_status, daemon.log_text().c_str());
+    sim.terminate();
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        if (argc < 2) {
+            std::fprintf(stderr, "usage: fb_bench_tcp_daemon FIELDBRIDGE [seconds=5]  (FIELDBRIDGE_SIM names the simulator)\n");
+            return 2;
+        }
+        const double seconds = argc > 2 ? std::atof(argv[2]) : 5.0;
+        if (seconds <= 0.0) {
+            std::fprintf(stderr, "fb_bench_tcp_daemon: seconds must be positive\n");
+            return 2;
+        }
+        return run(argv[1], seconds);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "fb_bench_tcp_daemon: %s\n", e.what());
+        return 1;
+    }
+}

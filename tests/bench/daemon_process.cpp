@@ -1,0 +1,112 @@
+#include "daemon_process.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace fieldbridge::bench {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+}
+
+DaemonProcess::DaemonProcess(const std::filesystem::path& binary, const std::filesystem::path& config,
+                             std::filesystem::path log, std::chrono::milliseconds ready_timeout)
+    : log_(std::move(log)) {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    std::vector<std::string> args{binary.string(), "--config", config.string()};
+    std::vector<char*> argv;
+    for (auto& arg : args) argv.push_back(arg.data());
+    argv.push_back(nullptr);
+    const int rc = posix_spawn(&pid_, binary.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) {
+        pid_ = -1;
+        throw std::runtime_error("cannot start " + binary.string() + ": error " + std::to_string(rc) +
+                                 "; build it first (tests/bench/run-benchmarks does)");
+    }
+    const auto deadline = Clock::now() + ready_timeout;
+    while (log_text().find("ready") == std::string::npos) {
+        int status = 0;
+        if (waitpid(pid_, &status, WNOHANG) == pid_) {
+            pid_ = -1;
+            throw std::runtime_error("fieldbridge exited during start-up; its log:\n" + log_text());
+        }
+        if (Clock::now() >= deadline) {
+            terminate();
+            throw std::runtime_error("fieldbridge did not log \"ready\" in time; its log:\n" + log_text());
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds{20});
+    }
+}
+
+DaemonProcess::~DaemonProcess() { terminate(); }
+
+double DaemonProcess::cpu_seconds() const {
+    std::ifstream in("/proc/" + std::to_string(pid_) + "/stat");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // Fields after the command name (which may hold spaces, so start after its ')').
+    const auto close = text.rfind(')');
+    if (close == std::string::npos) return 0.0;
+    std::istringstream fields(text.substr(close + 2));
+    std::string field;
+    double utime = 0.0;
+    double stime = 0.0;
+    for (int index = 3; fields >> field; ++index) {  // field 3 is the state
+        if (index == 14) utime = std::stod(field);
+        if (index == 15) {
+            stime = std::stod(field);
+            break;
+        }
+    }
+    return (utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+long DaemonProcess::rss_kib() const {
+    std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+    }
+    return 0;
+}
+
+int DaemonProcess::terminate(std::chrono::milliseconds timeout) {
+    if (pid_ <= 0) return exit_status_;
+    kill(pid_, SIGTERM);
+    const auto deadline = Clock::now() + timeout;
+    int status = 0;
+    while (waitpid(pid_, &status, WNOHANG) == 0) {
+        if (Clock::now() >= deadline) {
+            kill(pid_, SIGKILL);
+            waitpid(pid_, &status, 0);
+            pid_ = -1;
+            exit_status_ = -1;
+            return exit_status_;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds{10});
+    }
+    pid_ = -1;
+    exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return exit_status_;
+}
+
+std::string DaemonProcess::log_text() const {
+    std::ifstream in(log_);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace fieldbridge::bench

@@ -1,0 +1,41 @@
+#pragma once
+/// @file daemon_process.hpp
+/// The real `fieldbridge` daemon for the benchmarks: started with posix_spawn on a
+/// configuration file, its log (stdout and stderr) written to a file, "ready" awaited
+/// (bounded), stopped by PID (SIGTERM, then SIGKILL after a bounded wait). The
+/// destructor stops it in every path.
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+
+namespace fieldbridge::bench {
+
+class DaemonProcess {
+public:
+    /// Runs `@p binary --config @p config`, logging to @p log. Throws
+    /// std::runtime_error (with the log) when "ready" does not appear within
+    /// @p ready_timeout or the process exits first.
+    DaemonProcess(const std::filesystem::path& binary, const std::filesystem::path& config,
+                  std::filesystem::path log, std::chrono::milliseconds ready_timeout = std::chrono::seconds{20});
+    ~DaemonProcess();
+    DaemonProcess(const DaemonProcess&) = delete;
+    DaemonProcess& operator=(const DaemonProcess&) = delete;
+
+    [[nodiscard]] pid_t pid() const noexcept { return pid_; }
+    /// User + system CPU time the daemon used so far (from /proc/<pid>/stat).
+    [[nodiscard]] double cpu_seconds() const;
+    /// Resident set size in KiB (VmRSS of /proc/<pid>/status); 0 when unreadable.
+    [[nodiscard]] long rss_kib() const;
+    /// SIGTERM, bounded wait, SIGKILL; the exit status or -1 when killed. Idempotent.
+    int terminate(std::chrono::milliseconds timeout = std::chrono::seconds{10});
+    [[nodiscard]] std::string log_text() const;
+
+private:
+    std::filesystem::path log_;
+    pid_t pid_ = -1;
+    int exit_status_ = -1;
+};
+
+}  // namespace fieldbridge::bench
