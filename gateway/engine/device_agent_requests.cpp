@@ -120,6 +120,16 @@ void DeviceAgent::Impl::answer(const OperationPtr& op, protocol::Response respon
         --motion_commands_;
         motion_command_done_ = Clock::now();
     }
+    if (op->classification.motion && !std::holds_alternative<protocol::ExceptionResponse>(response)) {
+        // The status read before the device took the command says nothing about the
+        // motion it starts: until the next motion poll refreshes it, a client's read
+        // of it goes to the line (a fresh-looking "idle" right after a reset would
+        // tell a PLC the homing is already done).
+        for (const auto& item : polls_.plan().items()) {
+            if (!item.motion) continue;
+            for (const auto& span : item.fills) image_.mark_stale(span.table, span.address, span.count);
+        }
+    }
     post_answer(std::move(op->done), std::move(response));
 }
 

@@ -37,6 +37,8 @@ TEST_CASE("agent motion: a motion command polls status at the motion period unti
     rig.line.reply(command, fc16_ack(rig.line.at(command)));
     rig.await_answers(1);
     CHECK(rig.last_answer() == fp::Response{fp::WriteSingleResponse{fp::fc::write_single_register, 0x0601, 1}});
+    // The status polled before the command took effect is no longer served as fresh.
+    CHECK(rig.agent->image().quality(Table::input, 0x0301) == fe::Quality::stale);
 
     // Moving: still at the motion period.
     poll = next_status_poll(rig);
