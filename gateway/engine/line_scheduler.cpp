@@ -319,6 +319,10 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
     const DeviceIndex index = transaction.device;
     if (outcome.status == OutcomeStatus::ok) {
         device->consecutive_timeouts = 0;
+        if (const auto* response = std::get_if<protocol::Response>(&outcome.reply);
+            response != nullptr && std::holds_alternative<protocol::ExceptionResponse>(*response)) {
+            ++device->stats.device_exceptions;
+        }
         if (!device->online) bring_online(index, *device, now);
     } else if (outcome.status == OutcomeStatus::timeout) {
         ++device->consecutive_timeouts;

@@ -105,6 +105,8 @@ struct DeviceStats {
     std::array<ClassStats, priority_count> by_class{};  ///< indexed by Priority
     std::uint64_t went_offline = 0;
     std::uint64_t came_online = 0;
+    /// Valid replies that were Modbus exception responses (the device refused).
+    std::uint64_t device_exceptions = 0;
 
     [[nodiscard]] const ClassStats& of(Priority priority) const noexcept {
         return by_class[static_cast<std::size_t>(priority)];

@@ -56,6 +56,7 @@ json EngineDiag::collect(const engine::Engine& eng, engine::TimePoint now) {
         previous = Busy{c.busy_time, now};
 
         std::array<std::size_t, engine::priority_count> depth{};
+        std::uint64_t line_exceptions = 0;
         json devices = json::array();
         for (const auto& agent : line.agents) {
             const engine::DeviceStats* stats = worker.scheduler().stats(agent->config().index);
@@ -85,6 +86,8 @@ json EngineDiag::collect(const engine::Engine& eng, engine::TimePoint now) {
                 d["expired"] = expired;
                 d["queue_full"] = queue_full;
                 d["went_offline"] = stats->went_offline;
+                d["exceptions"] = stats->device_exceptions;
+                line_exceptions += stats->device_exceptions;
                 d["queue"] = std::move(queue);
                 d["wait_ms"] = std::move(wait);
             }
@@ -93,6 +96,7 @@ json EngineDiag::collect(const engine::Engine& eng, engine::TimePoint now) {
         json queue = json::object();
         for (std::size_t k = 0; k < engine::priority_count; ++k) queue[class_names[k]] = depth[k];
         out["queue"] = std::move(queue);
+        out["exceptions"] = line_exceptions;
         out["devices"] = std::move(devices);
         lines.push_back(std::move(out));
     }

@@ -75,6 +75,22 @@ TEST_CASE("scheduler: a command waits only for the transaction in flight") {
     const auto& command_stats = s.stats(0)->of(Priority::command);
     CHECK(command_stats.wait.count() == 1);
     CHECK(command_stats.wait.max() == 2ms);
+    CHECK(s.stats(0)->device_exceptions == 0);
+}
+
+TEST_CASE("scheduler: a device's exception replies are counted, and keep it online") {
+    auto s = make_scheduler();
+    Recorder r;
+    s.submit(tagged(write_tx(0, 1, 0x0601, 1), r, "refused"), t0);
+    auto t = s.next(t0);
+    REQUIRE(t.has_value());
+    fe::Outcome refused;
+    refused.status = OutcomeStatus::ok;
+    refused.reply = fp::Response{fp::ExceptionResponse{0x10, fp::ExceptionCode::server_device_failure}};
+    s.finished(std::move(*t), refused, t0 + 1ms);
+    CHECK(r.status("refused") == OutcomeStatus::ok);
+    CHECK(s.stats(0)->device_exceptions == 1);
+    CHECK(s.online(0));
 }
 
 TEST_CASE("scheduler: urgent commands jump every other queued command, first come first served") {
