@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include "temp_dir.hpp"
 
 extern char** environ;
 
@@ -44,12 +45,6 @@ private:
     int fd_;
 };
 
-std::filesystem::path make_temp_dir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "fb-engine-it-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error(errno_text("mkdtemp"));
-    return pattern;
-}
-
 std::string sim_binary() {
     const char* path = std::getenv("FIELDBRIDGE_SIM");
     if (path == nullptr || ::access(path, X_OK) != 0) {
@@ -76,7 +71,7 @@ int ms_left(Clock::time_point deadline) {
 }  // namespace
 
 SimProcess::SimProcess(const std::vector<std::string>& args, std::chrono::milliseconds ready_timeout)
-    : dir_(make_temp_dir()) {
+    : dir_(fieldbridge::test::make_temp_dir("fb-engine-it")) {
     try {
         const std::string binary = sim_binary();
         std::vector<std::string> argv_text{binary};

@@ -11,6 +11,7 @@
 #include "daemon/check_config.hpp"
 #include "daemon/config_summary.hpp"
 #include "daemon/exit_codes.hpp"
+#include "temp_dir.hpp"
 
 namespace daemon_ns = fieldbridge::daemon;
 namespace config = fieldbridge::config;
@@ -34,22 +35,13 @@ namespace {
 class TempFile {
 public:
     explicit TempFile(const std::string& text) {
-        std::string pattern = (std::filesystem::temp_directory_path() / "fb-daemon-XXXXXX").string();
-        REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-        dir_ = pattern;
-        path_ = dir_ / "gateway.yaml";
+        path_ = dir_.path() / "gateway.yaml";
         std::ofstream(path_) << text;
-    }
-    TempFile(const TempFile&) = delete;
-    TempFile& operator=(const TempFile&) = delete;
-    ~TempFile() {
-        std::error_code ignored;
-        std::filesystem::remove_all(dir_, ignored);
     }
     [[nodiscard]] const std::filesystem::path& path() const { return path_; }
 
 private:
-    std::filesystem::path dir_;
+    fieldbridge::test::TempDir dir_{"fb-daemon"};
     std::filesystem::path path_;
 };
 

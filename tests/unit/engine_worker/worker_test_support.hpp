@@ -32,6 +32,7 @@
 #include "engine/posix_serial_port.hpp"
 #include "protocol/modbus_pdu.hpp"
 #include "protocol/rtu_frame.hpp"
+#include "temp_dir.hpp"
 
 namespace worker_test {
 
@@ -43,27 +44,7 @@ using fe::Priority;
 using fe::Transaction;
 using fp::Bytes;
 
-/// A temporary directory, removed with its content.
-class TempDir {
-public:
-    TempDir() {
-        std::string pattern = (std::filesystem::temp_directory_path() / "fb-worker-XXXXXX").string();
-        if (::mkdtemp(pattern.data()) == nullptr) {
-            throw std::runtime_error(std::string("mkdtemp failed: ") + std::strerror(errno));
-        }
-        path_ = pattern;
-    }
-    ~TempDir() {
-        std::error_code ignored;
-        std::filesystem::remove_all(path_, ignored);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    [[nodiscard]] const std::filesystem::path& path() const { return path_; }
-
-private:
-    std::filesystem::path path_;
-};
+using fieldbridge::test::TempDir;
 
 /// What the device does with each request.
 struct DeviceScript {

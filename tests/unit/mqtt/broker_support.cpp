@@ -15,6 +15,7 @@
 #include <thread>
 
 #include <mqtt/async_client.h>
+#include "temp_dir.hpp"
 
 extern char** environ;
 
@@ -60,10 +61,7 @@ bool wait_for_listener(int port, std::chrono::milliseconds timeout) {
 }
 
 Mosquitto::Mosquitto(int port) : port_(port) {
-    char pattern[] = "/tmp/fb-mqtt-test-XXXXXX";
-    const char* dir = ::mkdtemp(pattern);
-    if (dir == nullptr) throw std::runtime_error("mkdtemp failed");
-    dir_ = dir;
+    dir_ = fieldbridge::test::make_temp_dir("fb-mqtt-test").string();
     std::ofstream conf(dir_ + "/mosquitto.conf");
     conf << "listener " << port_ << " 127.0.0.1\n"
          << "allow_anonymous true\n"

@@ -27,6 +27,7 @@
 #include "daemon/completion_barrier.hpp"
 #include "engine/engine.hpp"
 #include "northbound/mqtt/mqtt_component.hpp"
+#include "temp_dir.hpp"
 
 extern char** environ;
 
@@ -67,9 +68,8 @@ std::optional<json> expect(asio::io_context& io, Observer& observer, const std::
 }  // namespace
 
 TEST_CASE("MQTT component + engine + simulated XEG + mosquitto") {
-    char pattern[] = "/tmp/fb-mqtt-engine-XXXXXX";
-    REQUIRE(::mkdtemp(pattern) != nullptr);
-    const std::string dir = pattern;
+    const fieldbridge::test::TempDir tmp("fb-mqtt-engine");
+    const std::string dir = tmp.path().string();
     Mosquitto broker(free_port());
     broker.start();
     {

@@ -11,6 +11,7 @@
 #include "northbound/mqtt/paho_client.hpp"
 #include "northbound/mqtt/r6_source.hpp"
 #include "sim_process.hpp"
+#include "temp_dir.hpp"
 
 namespace {
 
@@ -46,9 +47,8 @@ std::optional<json> expect(asio::io_context& io, Observer& observer, const std::
 }  // namespace
 
 TEST_CASE("R6 units on MQTT: decoded state, alarm raise / clear, commands through the pass-through") {
-    char pattern[] = "/tmp/fb-mqtt-r6-XXXXXX";
-    REQUIRE(::mkdtemp(pattern) != nullptr);
-    const std::string dir = pattern;
+    const fieldbridge::test::TempDir tmp("fb-mqtt-r6");
+    const std::string dir = tmp.path().string();
     Mosquitto broker(free_port());
     broker.start();
     {

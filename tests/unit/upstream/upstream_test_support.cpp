@@ -20,6 +20,7 @@
 #include <asio/write.hpp>
 
 #include "protocol/mbap_frame.hpp"
+#include "temp_dir.hpp"
 
 extern char** environ;
 
@@ -132,9 +133,7 @@ std::string to_hex(const Bytes& bytes) {
 // ---- SimProcess ---------------------------------------------------------------
 
 SimProcess::SimProcess(std::uint16_t port) : port_(port) {
-    char tmpl[] = "/tmp/fb-upstream-XXXXXX";
-    if (::mkdtemp(tmpl) == nullptr) throw std::runtime_error("mkdtemp failed");
-    dir_ = tmpl;
+    dir_ = fieldbridge::test::make_temp_dir("fb-upstream").string();
     start();
 }
 
