@@ -22,6 +22,7 @@
 #include <spdlog/spdlog.h>
 
 #include "broker_support.hpp"
+#include "loop_support.hpp"
 #include "sim_process.hpp"
 #include "config/config_loader.hpp"
 #include "daemon/completion_barrier.hpp"
@@ -40,30 +41,6 @@ namespace fe = fieldbridge::engine;
 namespace fm = fieldbridge::northbound::mqtt;
 namespace fp = fieldbridge::protocol;
 namespace fd = fieldbridge::daemon;
-
-bool run_until(asio::io_context& io, const std::function<bool()>& done, std::chrono::milliseconds limit = 15s) {
-    const auto until = std::chrono::steady_clock::now() + limit;
-    while (!done()) {
-        if (std::chrono::steady_clock::now() > until) return false;
-        io.restart();
-        io.run_for(10ms);
-    }
-    return true;
-}
-
-std::optional<json> expect(asio::io_context& io, Observer& observer, const std::string& topic,
-                           const std::function<bool(const json&)>& match, std::size_t from = 0) {
-    std::optional<Received> found;
-    run_until(io, [&] {
-        found = observer.wait_for(topic, [&](const Received& r) {
-            const json j = json::parse(r.payload, nullptr, false);
-            return !j.is_discarded() && match(j);
-        }, 0ms, from);
-        return found.has_value();
-    });
-    if (!found) return std::nullopt;
-    return json::parse(found->payload);
-}
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "broker_support.hpp"
+#include "loop_support.hpp"
 #include "northbound/mqtt/mqtt_bridge.hpp"
 #include "northbound/mqtt/paho_client.hpp"
 #include "northbound/mqtt/r6_source.hpp"
@@ -19,30 +20,6 @@ using namespace fbt;
 using nlohmann::json;
 namespace fm = fieldbridge::northbound::mqtt;
 namespace fu = fieldbridge::northbound::upstream;
-
-bool run_until(asio::io_context& io, const std::function<bool()>& done, std::chrono::milliseconds limit = 15s) {
-    const auto until = std::chrono::steady_clock::now() + limit;
-    while (!done()) {
-        if (std::chrono::steady_clock::now() > until) return false;
-        io.restart();
-        io.run_for(10ms);
-    }
-    return true;
-}
-
-std::optional<json> expect(asio::io_context& io, Observer& observer, const std::string& topic,
-                           const std::function<bool(const json&)>& match, std::size_t from = 0) {
-    std::optional<Received> found;
-    run_until(io, [&] {
-        found = observer.wait_for(topic, [&](const Received& r) {
-            const json j = json::parse(r.payload, nullptr, false);
-            return !j.is_discarded() && match(j);
-        }, 0ms, from);
-        return found.has_value();
-    });
-    if (!found) return std::nullopt;
-    return json::parse(found->payload);
-}
 
 }  // namespace
 
