@@ -25,7 +25,9 @@ namespace fieldbridge::protocol::wtec {
 
 /// `B` reply / `b` request: 2+8+8+8+2+1+8+8 = 45 hex digits.
 struct HomingParams {
-    std::uint8_t mode = 0xFC;  ///< 0xFC reverse (closing) collision homing, 0xFD forward
+    /// 0xFC "reverse collision homing": homes at the open end (init direction 1, the
+    /// default); 0xFD forward: homes at the closed end (direction 2). docs/registers.md.
+    std::uint8_t mode = 0xFC;
     std::uint32_t speed = 0;
     std::uint32_t acceleration = 0;
     std::uint32_t offset = 0;
@@ -39,7 +41,7 @@ struct HomingParams {
 /// `N` reply / `n` request: 8+2+2+2+1 = 15 hex digits.
 struct GripperParams {
     std::uint32_t target = 0;      ///< target coordinate (encoder counts)
-    std::uint8_t max_current = 0;  ///< grip current at 100 % force in Modbus terms
+    std::uint8_t max_current = 0;  ///< the grip current (`C` sets it too)
     std::uint8_t speed = 0;        ///< 0x00-0xFF
     std::uint8_t confirm_time = 0;
     std::uint8_t home_at_power_up = 0;  ///< one hex digit
@@ -50,7 +52,7 @@ struct GripperParams {
 struct DriverParams {
     std::uint32_t max_speed = 0;
     std::uint32_t max_acceleration = 0;
-    std::uint8_t max_current = 0;
+    std::uint8_t max_current = 0;  ///< max running current: the current at 100 % Modbus force
     std::uint8_t damping = 0;  ///< one hex digit
     std::uint8_t program = 0;
     std::uint8_t mode = 0;
@@ -114,6 +116,7 @@ struct ReadStations { bool operator==(const ReadStations&) const = default; };  
 struct SetMotorEnable { bool enable = false; bool operator==(const SetMotorEnable&) const = default; };  // a
 struct ReadHoming { bool operator==(const ReadHoming&) const = default; };               // B
 struct WriteHoming { HomingParams params; bool operator==(const WriteHoming&) const = default; };      // b
+/// `C` "set the running peak current": the grip current, the `N` max current.
 struct SetPeakCurrent { std::uint8_t current = 0; bool operator==(const SetPeakCurrent&) const = default; };  // C
 struct SetTarget { std::int32_t target = 0; bool operator==(const SetTarget&) const = default; };      // D (8 hex)
 struct QueryGripState { bool operator==(const QueryGripState&) const = default; };       // d

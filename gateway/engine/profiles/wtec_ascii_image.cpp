@@ -33,13 +33,13 @@ void put_holding(RegisterImage& image, std::uint16_t address, std::uint16_t valu
     put(image, Table::holding, address, {value}, now);
 }
 
-/// Force 0x0103 = N max current as a share of R max current (seed 003 §2, force:
-/// "the maximum running current set over ASCII is the current at 100 %").
+/// Force 0x0103 = N max (grip) current as a share of R max current (seed 003 table
+/// 2.5: "the maximum running current set over ASCII is the current at 100 %").
 void refresh_force(RegisterImage& image, TimePoint now) {
     const auto current = image.value(Table::input, ext_n_current);
     const auto full = max_current_in(image);
     if (current && full) {
-        put_holding(image, force, wtec_raw_to_percent(*current, *full), now);
+        put_holding(image, force, wtec_force_percent(*current, *full), now);
     }
 }
 

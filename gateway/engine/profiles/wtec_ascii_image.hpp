@@ -25,7 +25,7 @@ void store_homing_code(RegisterImage& image, std::uint8_t code, TimePoint now);
 /// and force 0x0103 when R is known.
 void store_gripper(RegisterImage& image, const protocol::wtec::GripperParams& params, std::uint32_t stroke,
                    TimePoint now);
-/// An acknowledged `C`: N max current and force 0x0103.
+/// An acknowledged `C`: the grip current, i.e. N max current, and force 0x0103.
 void store_peak_current(RegisterImage& image, std::uint8_t current, TimePoint now);
 /// An acknowledged `D`: N target and position 0x0105.
 void store_target(RegisterImage& image, std::int32_t target, std::uint32_t stroke, TimePoint now);

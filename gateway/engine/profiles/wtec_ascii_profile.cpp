@@ -159,6 +159,19 @@ std::uint16_t wtec_raw_to_percent(std::int64_t raw, std::uint32_t full) noexcept
     return static_cast<std::uint16_t>((200 * r + full) / (2 * std::uint64_t{full}));  // nearest
 }
 
+std::uint16_t wtec_force_percent(std::uint32_t current, std::uint32_t full) noexcept {
+    if (full == 0) {
+        return 0;
+    }
+    const std::uint64_t percent = (std::uint64_t{current} * 100 + full / 2) / full;
+    return static_cast<std::uint16_t>(std::min<std::uint64_t>(percent, 100));
+}
+
+std::uint32_t wtec_force_current(std::uint16_t percent, std::uint32_t full) noexcept {
+    const std::uint64_t p = std::min<std::uint16_t>(percent, 100);
+    return static_cast<std::uint32_t>((p * full + 50) / 100);
+}
+
 std::uint16_t wtec_uniform_grip_state(std::uint8_t code) noexcept {
     switch (code) {
         case wtec::grip_state::released_to_limit:
@@ -242,7 +255,7 @@ std::vector<Payload> WtecAsciiProfile::to_line(const protocol::Request& request,
             case initialize: out.push_back(AsciiPayload{wtec::Home{}}); break;
             case estop: out.push_back(AsciiPayload{wtec::SetMotorEnable{false}}); break;
             case force: {
-                const auto current = static_cast<std::uint8_t>(wtec_percent_to_raw(value, full_current));
+                const auto current = static_cast<std::uint8_t>(wtec_force_current(value, full_current));
                 out.push_back(AsciiPayload{wtec::SetPeakCurrent{current}});
                 if (n) {
                     n->max_current = current;

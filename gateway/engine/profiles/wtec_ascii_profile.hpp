@@ -12,7 +12,8 @@
 ///   0x0100 = 1     -> `G` (home)
 ///   0x0102 = 1     -> `a0` (release the motor); the gateway latches 0x0102 = 1
 ///                     until an acknowledged `G` clears it
-///   0x0103 = f %   -> `C` peak current = ceil(f x R.max_current / 100)
+///   0x0103 = f %   -> `C` grip current = round(f x R.max_current / 100) (C sets the
+///                     N max current; force reads round(N.max x 100 / R.max))
 ///   0x0104 = s %   -> `n` with the other N fields as read, speed = ceil(s x 255 / 100)
 ///   0x0105 = p     -> `D` target = ceil(p x stroke / 100) (D moves there)
 ///   0x0300 = 1 / 2 -> `b` with the other B fields as read, mode 0xFC / 0xFD
@@ -37,6 +38,14 @@ namespace fieldbridge::engine {
 /// when no percentage gives @p raw; 0 for @p raw <= 0 or @p full == 0, 100 for
 /// @p raw >= @p full.
 [[nodiscard]] std::uint16_t wtec_raw_to_percent(std::int64_t raw, std::uint32_t full) noexcept;
+
+/// Force 0x0103 from the grip current (`N` max current, also set by `C`) over the
+/// current at 100 % (`R` max current, seed 003 table 2.5): round(@p current x 100 /
+/// @p full), at most 100; 0 when @p full is 0.
+[[nodiscard]] std::uint16_t wtec_force_percent(std::uint32_t current, std::uint32_t full) noexcept;
+/// The `C` grip current for force @p percent (clamped to 100): round(@p percent x
+/// @p full / 100). Every percentage reads back unchanged when @p full >= 100.
+[[nodiscard]] std::uint32_t wtec_force_current(std::uint16_t percent, std::uint32_t full) noexcept;
 
 /// Uniform grip state (0x0202) from the `d` / `I` code: 00->0, 01->1, 02->2, 05->1
 /// (released to the limit: stopped, no object), 06->1 (closed to the limit without

@@ -270,19 +270,45 @@ OpTable excd_ops() {
 
 // ---- WTEC-485, both modes: the uniform map (seed 003 part 2) --------------------
 
-OpTable wtec_ops() {
+constexpr std::uint16_t wtec_init_direction = 0x0300;  // holding: 1 open, 2 close
+constexpr std::uint16_t wtec_direction_open = 1;
+constexpr std::uint16_t wtec_direction_close = 2;
+
+/// The position (0x0105) that closes (@p close) or opens the jaws. Position 0 % is the
+/// end the gripper homes to (seed 003 table 2.9: direction 1 runs to the maximum
+/// opening "as the initial start point", 2 to the minimum closing), so closing is
+/// 100 % with direction 1 and 0 % with direction 2.
+std::uint16_t wtec_jaw_position(std::span<const RawRegister> registers, bool close, const char* op) {
+    const auto it = std::find_if(registers.begin(), registers.end(), [](const RawRegister& r) {
+        return r.table == engine::Table::holding && r.address == wtec_init_direction;
+    });
+    const std::string what = std::string("op '") + op + "' needs the gripper's init direction (holding 0x0300), ";
+    const std::string instead = "; retry in a few seconds (it is polled every `poll.slow`) or use the 'position' op "
+                                "with an explicit percent; nothing was sent";
+    if (it == registers.end()) {
+        throw Refusal{CommandErrorKind::state_unknown, what + "which was not read from the device yet" + instead};
+    }
+    if (it->value != wtec_direction_open && it->value != wtec_direction_close) {
+        throw Refusal{CommandErrorKind::state_unknown,
+                      what + "which reads " + std::to_string(it->value) + " (neither 1 open nor 2 close)" + instead};
+    }
+    const bool zero_is_open = it->value == wtec_direction_open;
+    return close == zero_is_open ? 100 : 0;
+}
+
+OpTable wtec_ops(std::span<const RawRegister> registers) {
     // Optional force / speed first, then the position that moves the jaws.
-    const auto approach = [](Fields& f, std::uint16_t position) {
+    const auto approach = [registers](Fields& f, bool close, const char* op) {
         std::vector<Request> out;
         if (f.has("force_pct")) out.push_back(single(0x0103, static_cast<std::uint16_t>(f.integer("force_pct", 20, 100))));
         if (f.has("speed_pct")) out.push_back(single(0x0104, static_cast<std::uint16_t>(f.integer("speed_pct", 1, 100))));
-        out.push_back(single(0x0105, position));
+        out.push_back(single(0x0105, wtec_jaw_position(registers, close, op)));
         return out;
     };
     return {
         {"init", [](Fields&) { return std::vector<Request>{single(0x0100, 1)}; }},
-        {"grip", [approach](Fields& f) { return approach(f, 0); }},
-        {"release", [approach](Fields& f) { return approach(f, 100); }},
+        {"grip", [approach](Fields& f) { return approach(f, true, "grip"); }},
+        {"release", [approach](Fields& f) { return approach(f, false, "release"); }},
         {"position",
          [](Fields& f) {
              return std::vector<Request>{single(0x0105, static_cast<std::uint16_t>(f.integer("percent", 0, 100)))};
@@ -330,12 +356,12 @@ OpTable r6_ops() {
     };
 }
 
-OpTable ops_of(CommandSet set) {
+OpTable ops_of(CommandSet set, std::span<const RawRegister> registers) {
     OpTable table;
     switch (set) {
         case CommandSet::xeg: table = xeg_ops(); break;
         case CommandSet::excd: table = excd_ops(); break;
-        case CommandSet::wtec: table = wtec_ops(); break;
+        case CommandSet::wtec: table = wtec_ops(registers); break;
         case CommandSet::r6: table = r6_ops(); break;
         case CommandSet::generic: break;
     }
@@ -354,17 +380,18 @@ std::string_view to_string(CommandErrorKind kind) noexcept {
         case CommandErrorKind::missing_field: return "missing_field";
         case CommandErrorKind::invalid_field: return "invalid_field";
         case CommandErrorKind::out_of_range: return "out_of_range";
+        case CommandErrorKind::state_unknown: return "state_unknown";
     }
     return "unknown";
 }
 
 std::vector<std::string_view> command_ops(CommandSet set) {
     std::vector<std::string_view> names;
-    for (const auto& [name, op] : ops_of(set)) names.push_back(name);
+    for (const auto& [name, op] : ops_of(set, {})) names.push_back(name);
     return names;
 }
 
-ParseResult parse_command(std::string_view payload, CommandSet set) {
+ParseResult parse_command(std::string_view payload, CommandSet set, std::span<const RawRegister> registers) {
     const json command = json::parse(payload, nullptr, /*allow_exceptions=*/false);
     if (command.is_discarded() || !command.is_object()) {
         return CommandError{CommandErrorKind::bad_json, "the command must be a JSON object", json(), {}};
@@ -380,7 +407,7 @@ ParseResult parse_command(std::string_view payload, CommandSet set) {
         return CommandError{CommandErrorKind::unknown_op, "field 'op' (a string) is required", id, {}};
     }
     const auto op = op_it->get<std::string>();
-    const OpTable table = ops_of(set);
+    const OpTable table = ops_of(set, registers);
     const auto entry = std::find_if(table.begin(), table.end(), [&](const auto& e) { return e.first == op; });
     if (entry == table.end()) {
         std::string known;

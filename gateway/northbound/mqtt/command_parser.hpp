@@ -6,7 +6,10 @@
 /// parser checks JSON types and the ranges it can know without the device (16-bit
 /// registers, signed 32-bit positions, enumerations); the device's profile checks the
 /// rest (model-dependent strokes, protected registers) before anything is sent.
-/// Pure.
+/// Some ops depend on the device's registers: WTEC `grip` / `release` move to 100 %
+/// or 0 % depending on the init direction (holding 0x0300), since 0 % is the end the
+/// gripper homes to (docs/registers.md). Pure.
+#include <span>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -35,8 +38,10 @@ enum class CommandErrorKind : std::uint8_t {
     missing_field,
     invalid_field,  ///< wrong JSON type, or a field the op does not take
     out_of_range,
+    state_unknown,  ///< the op needs a device register the gateway has no usable value of
 };
-/// "bad_json", "missing_id", "unknown_op", "missing_field", "invalid_field", "out_of_range".
+/// "bad_json", "missing_id", "unknown_op", "missing_field", "invalid_field", "out_of_range",
+/// "state_unknown".
 [[nodiscard]] std::string_view to_string(CommandErrorKind kind) noexcept;
 
 struct CommandError {
@@ -48,7 +53,10 @@ struct CommandError {
 
 using ParseResult = std::variant<ParsedCommand, CommandError>;
 
-[[nodiscard]] ParseResult parse_command(std::string_view payload, CommandSet set);
+/// @p registers: the device's register image as the source shows it
+/// (SourceState::raw: every register that has a value); ops that need none ignore it.
+[[nodiscard]] ParseResult parse_command(std::string_view payload, CommandSet set,
+                                        std::span<const RawRegister> registers);
 
 /// The ops of @p set, for error messages and docs.
 [[nodiscard]] std::vector<std::string_view> command_ops(CommandSet set);

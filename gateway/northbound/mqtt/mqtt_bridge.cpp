@@ -392,8 +392,10 @@ private:
         ++stats_.commands;
         const ParseResult parsed = [&]() -> ParseResult {
             const auto it = devices_.find(name);
-            const CommandSet set = it == devices_.end() ? CommandSet::generic : it->second->source->command_set();
-            return parse_command(message.payload, set);
+            if (it == devices_.end()) return parse_command(message.payload, CommandSet::generic, {});
+            // Some ops depend on the device's registers (WTEC grip / release: the init direction).
+            const DeviceSource& source = *it->second->source;
+            return parse_command(message.payload, source.command_set(), source.state().raw);
         }();
         json id;
         std::string op;

@@ -18,12 +18,9 @@ namespace {
 using engine::Table;
 
 /// The readable registers of the uniform map, except 0x0302 (W only in the ASCII
-/// view), 0x0303 (each device's own address) and force 0x0103: the gateway's ASCII
-/// view reads force as `N` max current / `R` max current (product spec §5's table),
-/// while the simulator's gripper takes force as the `C` peak current / `N` max
-/// current, so the two faces disagree on it by design of the two models (95 % vs
-/// 99 % at power-up). Reported to the lead; not a property of the line engine.
-constexpr std::array<std::uint16_t, 7> compared{0x0102, 0x0104, 0x0105, 0x0200, 0x0202, 0x0204, 0x0300};
+/// view) and 0x0303 (each device's own address). Force 0x0103 is the `N` max (grip)
+/// current over the `R` max current in both (docs/registers.md).
+constexpr std::array<std::uint16_t, 8> compared{0x0102, 0x0103, 0x0104, 0x0105, 0x0200, 0x0202, 0x0204, 0x0300};
 
 class TwoFaces {
 public:
@@ -104,6 +101,7 @@ lines:
         seconds{3}));
     TwoFaces grippers(h, sim);
     grippers.same_state("power-up");
+    CHECK(grippers.read(0x0103).second == 100);  // N max 0x3F over R max 0x3F
     CHECK(grippers.read(0x0200).second == 0);  // not initialised
     CHECK(grippers.read(0x0202).second == 11);  // motor released
 
@@ -113,14 +111,19 @@ lines:
     REQUIRE(grippers.wait_for(0x0202, 1));
     grippers.same_state("initialised");
 
-    // Force (acknowledged by both; see `compared`), speed, then a move to half the stroke.
+    // Force (the grip current round(60 x 63 / 100) = 38 in both: 60 %), speed, then a
+    // move to half the stroke.
     grippers.write(0x0103, 60);
     grippers.write(0x0104, 50);
     grippers.write(0x0105, 50);
     REQUIRE(grippers.wait_for(0x0204, 50));
     REQUIRE(grippers.wait_for(0x0202, 1));
     grippers.same_state("moved to 50 %");
+    CHECK(grippers.read(0x0103).second == 60);
     CHECK(grippers.read(0x0104).second == 50);
+    // 80 % is round(50.4) = 50, which both read as 79 %.
+    grippers.write(0x0103, 80);
+    REQUIRE(grippers.wait_for(0x0103, 79));
 
     // An object that leaves 30 % of the opening: closing fully grips it.
     grippers.both("object 30");

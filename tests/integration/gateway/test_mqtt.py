@@ -163,8 +163,9 @@ class Commands(MqttCell):
         self.command("stepper-1", {"op": "stop", "immediate": True})
         self.command("stepper-1", {"op": "home"})
         self.command("stepper-1", {"op": "stop"})
-        # wtec-rtu and wtec-ascii
-        for device, unit in (("gripper-3", 4), ("gripper-2", 3)):
+        # wtec-rtu and wtec-ascii. `grip` closes and `release` opens whichever end the
+        # gripper homes to (0 %): the simulator meets an object only while closing.
+        for device, unit, sim_device in (("gripper-3", 4, "line-b@1"), ("gripper-2", 3, "line-a@5")):
             self.command(device, {"op": "init"})
             self.wait_value(lambda: self.read_holding(client, 0x0200, 1, unit), [1], MOTION_TIMEOUT,
                             "%s initialised" % device)
@@ -175,12 +176,37 @@ class Commands(MqttCell):
             simlib.wait_until(lambda: self.command(device, {"op": "force", "percent": 70}, ok=None)["ok"],
                               10.0, interval=0.3)
             self.command(device, {"op": "speed", "percent": 90})
+            self.assertEqual(self.read_holding(client, 0x0300, 1, unit), [1])
+            # Init direction 1 (default): homed at the open end, so open is 0 %.
             self.command(device, {"op": "release", "force_pct": 50, "speed_pct": 100})
-            self.wait_value(lambda: self.read_holding(client, 0x0204, 1, unit), [100], MOTION_TIMEOUT,
-                            "%s released" % device)
+            self.wait_value(lambda: self.read_holding(client, 0x0202, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [1, 0], MOTION_TIMEOUT,
+                            "%s released (open, 0 %%)" % device)
+            self.control("device %s object 30" % sim_device)
             self.command(device, {"op": "grip"})
-            self.wait_value(lambda: self.read_holding(client, 0x0204, 1, unit), [0], MOTION_TIMEOUT,
-                            "%s closed" % device)
+            self.wait_value(lambda: self.read_holding(client, 0x0202, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [2, 70], MOTION_TIMEOUT,
+                            "%s gripped the 30 %% object (closing towards 100 %%)" % device)
+            self.control("device %s object none" % sim_device)
+            # Init direction 2: homed at the closed end, so closed is 0 % and open 100 %.
+            # (0x0204 reads 0 only once this homing is over: the jaws stand 30 % open.)
+            self.command(device, {"op": "set_register", "address": 0x0300, "value": 2})
+            self.command(device, {"op": "init"})
+            self.wait_value(lambda: self.read_holding(client, 0x0300, 1, unit)
+                            + self.read_holding(client, 0x0200, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [2, 1, 0], MOTION_TIMEOUT,
+                            "%s initialised at the closed end" % device)
+            self.command(device, {"op": "release"})
+            self.wait_value(lambda: self.read_holding(client, 0x0202, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [1, 100], MOTION_TIMEOUT,
+                            "%s released (open, 100 %%)" % device)
+            self.control("device %s object 30" % sim_device)
+            self.command(device, {"op": "grip"})
+            self.wait_value(lambda: self.read_holding(client, 0x0202, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [2, 30], MOTION_TIMEOUT,
+                            "%s gripped the 30 %% object (closing towards 0 %%)" % device)
+            self.control("device %s object none" % sim_device)
+            self.command(device, {"op": "set_register", "address": 0x0300, "value": 1})
             self.command(device, {"op": "estop"})
             self.wait_value(lambda: self.read_holding(client, 0x0102, 1, unit), [1], TIMEOUT,
                             "%s e-stop latched" % device)

@@ -210,7 +210,11 @@ class Motion(simlib.SimTestCase):
         self.assertTrue(simlib.wait_until(lambda: self.ascii(fd, ">05g") == "01", MOTION_TIMEOUT))
         self.assertEqual(self.ascii(fd, ">05d"), "01")
         # Grip an object 40 % of the opening wide: closing stops at 60 % of the stroke
-        # (12000 counts of 20000) with state 02 and the grip current (C = 3C).
+        # (12000 counts of 20000) with state 02 and the grip current, which `C` sets as
+        # the N max current (characters 8-9 of N; power-up 3F).
+        self.assertEqual(self.ascii(fd, ">05N")[8:10], "3F")
+        self.ascii(fd, ">05C3C")
+        self.assertEqual(self.ascii(fd, ">05N")[8:10], "3C")
         self.assertEqual(self.control("device 5 object 40"), "ok")
         self.ascii(fd, ">05E1")
         self.assertTrue(simlib.wait_until(lambda: self.ascii(fd, ">05d") == "02", MOTION_TIMEOUT))

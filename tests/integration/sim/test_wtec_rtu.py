@@ -64,7 +64,9 @@ class WtecRtu(simlib.SimTestCase):
         self.wait_reg(fd, 0x0200, 1)
         self.assertEqual(self.reg(fd, 0x0202), 1)
         self.example(fd, "force 0x0103=80%")
-        self.example_read(fd, "read force 0x0103", 80)
+        # Force is the N max (grip) current over R's max current 0x3F: 80 % sets
+        # round(50.4) = 50, which reads round(5000 / 63) = 79 % (docs/registers.md).
+        self.example_read(fd, "read force 0x0103", 79)
         self.example(fd, "force 0x0103=100%")
         self.example(fd, "position 0x0105=50")
         self.example_read(fd, "read set position 0x0105", 50)

@@ -34,7 +34,7 @@ struct Executor {
         return ack();
     }
     Result operator()(const wtec::SetPeakCurrent& c) const {
-        gripper.set_peak_current(c.current);
+        gripper.set_grip_current(c.current);  // the N max current
         return ack();
     }
     Result operator()(const wtec::SetTarget& c) const {

@@ -26,13 +26,14 @@ std::int64_t rounded_div(std::int64_t num, std::int64_t den) noexcept {
 WtecGripper::WtecGripper(std::uint32_t stroke) : stroke_(stroke) {
     // Power-up parameters are the manual's own examples (seed 003 commands 4, 14, 16,
     // 18, 21), except the N target (0: the jaws are at position 0) and home-at-power-up
-    // (0: the Modbus example reads 0x0200 = 0, "not initialized", after power-up).
+    // (0: the Modbus example reads 0x0200 = 0, "not initialized", after power-up). The
+    // grip current is N's 0x3F; R's max current (decoded by position) is 0x3F too, so
+    // the force reads 100 % until `C`, `n` or 0x0103 changes it.
     homing_ = {homing_mode_open, 0x7530, 0x30D40, 0x3E8, 0x41, 1, 0xC8, 0x989680};
     gripper_ = {0, 0x3F, 0xFF, 0x0A, 0};
     driver_ = {0x0007A120, 0x004C4B40, 0x3F, 0, 0x03, 0x02, 0x2710, 0x00000104, 0};
     pid_ = {0x0080, 0x0000, 0x0090};
     release_ = {0x5C, 0xFF};
-    set_peak_current(0x3C);  // seed 003 command 6 example
 }
 
 void WtecGripper::advance(Clock::time_point now) {
@@ -194,27 +195,21 @@ std::uint8_t WtecGripper::grip_state() const noexcept {
 
 std::uint8_t WtecGripper::current() const noexcept {
     if (!enabled_) return 0;
-    if (motion_) return closing_ ? peak_current_ : release_.current;
-    if (homed_ && outcome_ == wtec::grip_state::gripped) return peak_current_;
+    if (motion_) return closing_ ? grip_current() : release_.current;
+    if (homed_ && outcome_ == wtec::grip_state::gripped) return grip_current();
     return rest_current;
 }
 
-void WtecGripper::set_gripper_params(const wtec::GripperParams& params) noexcept {
-    gripper_ = params;
-    set_peak_current(peak_current_);  // the force follows the new max current
-}
-
-void WtecGripper::set_peak_current(std::uint8_t current) noexcept {
-    peak_current_ = current;
-    const std::int64_t percent =
-        gripper_.max_current == 0 ? 100 : rounded_div(std::int64_t{current} * 100, gripper_.max_current);
-    force_percent_ = static_cast<std::uint16_t>(percent > 100 ? 100 : percent);
-}
-
 void WtecGripper::set_force_percent(std::uint16_t percent) noexcept {
-    // seed 003 part 2 (力值): 100 % is the max current set over the ASCII protocol.
-    force_percent_ = percent;
-    peak_current_ = static_cast<std::uint8_t>(rounded_div(std::int64_t{percent} * gripper_.max_current, 100));
+    const std::int64_t current = rounded_div(std::int64_t{percent} * driver_.max_current, 100);
+    gripper_.max_current = static_cast<std::uint8_t>(current > 0xFF ? 0xFF : current);
+}
+
+std::uint16_t WtecGripper::force_percent() const noexcept {
+    // seed 003 table 2.5: the max running current set over ASCII is the 100 % current.
+    if (driver_.max_current == 0) return 100;
+    const std::int64_t percent = rounded_div(std::int64_t{gripper_.max_current} * 100, driver_.max_current);
+    return static_cast<std::uint16_t>(percent > 100 ? 100 : percent);
 }
 
 void WtecGripper::set_speed_percent(std::uint16_t percent) noexcept {

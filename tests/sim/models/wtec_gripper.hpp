@@ -14,9 +14,15 @@
 /// Speeds: a move at speed byte s (0-0xFF) covers 2 * stroke * s / 255 counts per
 /// second (a full stroke in 0.5 s at 0xFF); homing runs at the `B` homing speed
 /// (at least 1000 counts/s), then waits the `B` confirm time in ms.
-/// Currents (`I`): 0 with the motor released, the peak current (`C`) while closing or
+/// Currents (`I`): 0 with the motor released, the grip current while closing or
 /// holding an object, the release current (`W`) while opening, 3 at rest (the `I`
 /// example reads 03 after a release).
+///
+/// Force (docs/registers.md, wtec-rtu): there is one grip current, the `N` max current;
+/// `C` sets it. The Modbus force 0x0103 is that current as a share of the `R` max
+/// current ("the max running current set over ASCII is the current at 100 %", seed 003
+/// table 2.5): force = round(N max x 100 / R max), capped at 100; writing force f sets
+/// N max = round(f x R max / 100). Both faces therefore read the same gripper alike.
 
 #include <cstdint>
 #include <optional>
@@ -69,7 +75,7 @@ public:
     void set_homing_params(const protocol::wtec::HomingParams& params) noexcept { homing_ = params; }
     [[nodiscard]] const protocol::wtec::GripperParams& gripper_params() const noexcept { return gripper_; }
     /// `n`: stores the parameters (the target too, without moving).
-    void set_gripper_params(const protocol::wtec::GripperParams& params) noexcept;
+    void set_gripper_params(const protocol::wtec::GripperParams& params) noexcept { gripper_ = params; }
     [[nodiscard]] const protocol::wtec::DriverParams& driver_params() const noexcept { return driver_; }
     void set_driver_params(const protocol::wtec::DriverParams& params) noexcept { driver_ = params; }
     [[nodiscard]] const protocol::wtec::Pid& pid() const noexcept { return pid_; }
@@ -77,12 +83,14 @@ public:
     [[nodiscard]] const protocol::wtec::ReleaseParams& release_params() const noexcept { return release_; }
     void set_release_params(const protocol::wtec::ReleaseParams& params) noexcept { release_ = params; }
 
-    /// `C`: grip (peak) current; the Modbus force follows as current / max current.
-    void set_peak_current(std::uint8_t current) noexcept;
-    [[nodiscard]] std::uint8_t peak_current() const noexcept { return peak_current_; }
-    /// 0x0103: force 20-100 % of the `N` max current (seed 003 part 2, 力值).
+    /// `C`: the grip current, which is the `N` max current (the force follows).
+    void set_grip_current(std::uint8_t current) noexcept { gripper_.max_current = current; }
+    [[nodiscard]] std::uint8_t grip_current() const noexcept { return gripper_.max_current; }
+    /// 0x0103 write: N max current = round(@p percent x `R` max current / 100), at most 0xFF.
     void set_force_percent(std::uint16_t percent) noexcept;
-    [[nodiscard]] std::uint16_t force_percent() const noexcept { return force_percent_; }
+    /// 0x0103 read: round(N max current x 100 / `R` max current), capped at 100 (100
+    /// with an `R` max current of 0).
+    [[nodiscard]] std::uint16_t force_percent() const noexcept;
     /// 0x0104: speed 1-100 % of the `N` speed byte range.
     void set_speed_percent(std::uint16_t percent) noexcept;
     [[nodiscard]] std::uint16_t speed_percent() const noexcept;
@@ -139,8 +147,6 @@ private:
     protocol::wtec::DriverParams driver_;
     protocol::wtec::Pid pid_;
     protocol::wtec::ReleaseParams release_;
-    std::uint8_t peak_current_;
-    std::uint16_t force_percent_ = 0;
 };
 
 }  // namespace fieldbridge::sim

@@ -7,9 +7,9 @@
 /// |----------|-----------------------------------------|------------------------------------|
 /// | 0x0100   | 0                                       | 1: initialize (home)               |
 /// | 0x0102   | e-stop latch 0/1                        | 1: e-stop (cleared by 0x0100 only) |
-/// | 0x0103   | force 20-100 %                          | 20-100                             |
+/// | 0x0103   | force: N max / R max current, %         | 20-100: N max = % x R max / 100    |
 /// | 0x0104   | speed 1-100 %                           | 1-100                              |
-/// | 0x0105   | set position 0-100 (target / stroke)    | 0-100: move there                  |
+/// | 0x0105   | set position 0-100 (target / stroke)    | 0-100: move there (0 = homing end) |
 /// | 0x0200   | init state 0 no, 1 done, 2 failed, 9 busy| -                                 |
 /// | 0x0202   | grip state 0 moving, 1 reached, 2 gripped, 11 released / not homed | -       |
 /// | 0x0204   | instant position 0-100                  | -                                  |

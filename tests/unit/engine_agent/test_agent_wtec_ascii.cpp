@@ -90,7 +90,7 @@ TEST_CASE("agent wtec ascii: a write becomes ASCII commands submitted one after 
     rig.line.reply(sent[0], ascii_reply(rig.line.at(sent[0]), fw::Ack{}));
     sent = commands(rig.line);
     REQUIRE(sent.size() == 2);
-    // 0x0104 speed 60 % -> n with N as read and the new peak current, speed 153.
+    // 0x0104 speed 60 % -> n with N as read and the new grip current (N max current), speed 153.
     fw::GripperParams n = gripper();
     n.max_current = 100;
     n.speed = 153;

@@ -1,6 +1,7 @@
 // The WTEC ASCII uniform register view (spec §5; docs/registers.md), both ways.
 #include <doctest/doctest.h>
 
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,30 @@ TEST_CASE("wtec-ascii: percentages and raw values round-trip") {
     CHECK(fe::wtec_raw_to_percent(stroke + 5, stroke) == 100);
     CHECK(fe::wtec_raw_to_percent(7, 0) == 0);
     CHECK(fe::wtec_raw_to_percent(4, 255) == 2);  // 4 is no percentage's value: nearest
+}
+
+TEST_CASE("wtec-ascii: force is the grip current over R's max current, rounded") {
+    // docs/registers.md: force % = round(N max x 100 / R max), capped at 100; a force
+    // write sends C = round(f x R max / 100).
+    CHECK(fe::wtec_force_percent(0x3F, 0x3F) == 100);
+    CHECK(fe::wtec_force_percent(0x3F, 0x78) == 53);  // 52.5, rounded up
+    CHECK(fe::wtec_force_percent(50, 0x3F) == 79);
+    CHECK(fe::wtec_force_percent(0x3F, 0x3E) == 100);  // above R's max: capped
+    CHECK(fe::wtec_force_percent(0, 0x3F) == 0);
+    CHECK(fe::wtec_force_percent(10, 0) == 0);
+    CHECK(fe::wtec_force_current(80, 0x3F) == 50);
+    CHECK(fe::wtec_force_current(50, 0x3F) == 32);  // 31.5, rounded up
+    CHECK(fe::wtec_force_current(150, 0x3F) == 0x3F);  // clamped to 100 %
+    for (const std::uint32_t full : {100U, 0x78U, 0xFFU}) {
+        for (std::uint16_t p = 0; p <= 100; ++p) {
+            CHECK(fe::wtec_force_percent(fe::wtec_force_current(p, full), full) == p);
+        }
+    }
+    // Below 100 steps a percentage comes back within 1.
+    for (std::uint16_t p = 20; p <= 100; ++p) {
+        const int back = fe::wtec_force_percent(fe::wtec_force_current(p, 0x3F), 0x3F);
+        CHECK(std::abs(back - p) <= 1);
+    }
 }
 
 TEST_CASE("wtec-ascii: state codes in the uniform registers") {
@@ -264,9 +289,11 @@ TEST_CASE("wtec-ascii: writes become ASCII commands") {
     CHECK(command_of(seq[1]) == fw::Command{fw::WriteGripper{gripper(5000, 60, 0xFF)}});
     CHECK(command_of(seq[2]) == fw::Command{fw::SetTarget{4000}});
 
-    // With R's max current 63 (seed 003's example), 50 % is ceil(31.5) = 32.
+    // With R's max current 63 (seed 003's example), 50 % is round(31.5) = 32 and
+    // 80 % is round(50.4) = 50.
     (void)v.feed(fw::ReadDriver{}, driver(63));
     CHECK(one(write_single(0x0103, 50)) == fw::Command{fw::SetPeakCurrent{32}});
+    CHECK(one(write_single(0x0103, 80)) == fw::Command{fw::SetPeakCurrent{50}});
 }
 
 TEST_CASE("wtec-ascii: acknowledged writes update the view; the e-stop latch") {

@@ -58,6 +58,11 @@ public:
         state_.updated = fe::Clock::now();
         changed();
     }
+    /// Adds a register to the raw image (e.g. a WTEC's init direction, holding 0x0300).
+    void add_register(fm::RawRegister r) {
+        state_.raw.push_back(r);
+        changed();
+    }
     void set_online(bool online) {
         state_.online = online;
         state_.quality = online ? fe::Quality::good : fe::Quality::offline;

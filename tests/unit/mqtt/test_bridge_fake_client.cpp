@@ -1,5 +1,6 @@
 // The bridge over a scripted client: bounded in-flight and outbox while the broker is
-// slow, back-off of reconnection attempts, clean stop, retained commands refused.
+// slow, back-off of reconnection attempts, clean stop, retained commands refused,
+// commands that depend on the device's registers.
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>
@@ -183,4 +184,43 @@ TEST_CASE("bridge: a retained command is never executed") {
     log->events.message(fm::Message{"p/g1/cmd", R"({"id":2,"op":"stop"})", 1, false});
     run(io, 20ms);
     CHECK(source->executed.size() == 1);
+}
+
+TEST_CASE("bridge: WTEC grip uses the device's init direction; unknown, nothing is sent") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    auto source = std::make_shared<FakeSource>(io, "w1", fm::CommandSet::wtec);
+    bridge.set_sources({source});
+    bridge.start();
+    run(io, 20ms);
+    const auto result_of = [&](int id) {
+        json found;
+        for (const auto& m : log->published) {
+            if (m.topic == "p/w1/cmd/result" && json::parse(m.payload)["id"] == id) found = json::parse(m.payload);
+        }
+        return found;
+    };
+    std::size_t acked = 0;
+    const auto settle = [&] {  // the broker acknowledges everything published so far
+        for (int round = 0; round < 4; ++round) {
+            run(io, 10ms);
+            for (; acked < log->ids.size(); ++acked) log->events.published(log->ids[acked], true);
+        }
+    };
+    // The image has no holding 0x0300 yet (only the fake's input 0x0300).
+    log->events.message(fm::Message{"p/w1/cmd", R"({"id":1,"op":"grip"})", 1, false});
+    settle();
+    CHECK(source->executed.empty());
+    const json refused = result_of(1);
+    CHECK(refused["ok"] == false);
+    CHECK(refused["error"] == "state_unknown");
+    CHECK(refused["message"].get<std::string>().find("init direction") != std::string::npos);
+    // Direction 2 (homes at the closed end): closing is 0 %.
+    source->add_register(fm::RawRegister{fe::Table::holding, 0x0300, 2});
+    log->events.message(fm::Message{"p/w1/cmd", R"({"id":2,"op":"grip"})", 1, false});
+    settle();
+    REQUIRE(source->executed.size() == 1);
+    CHECK(source->executed[0] == fp::Request{fp::WriteSingleRegisterRequest{0x0105, 0}});
+    CHECK(result_of(2)["ok"] == true);
 }

@@ -10,8 +10,15 @@ namespace fe = fieldbridge::engine;
 namespace fm = fieldbridge::northbound::mqtt;
 namespace fp = fieldbridge::protocol;
 
-std::vector<fp::Request> requests(const std::string& payload, fm::CommandSet set) {
-    const auto result = fm::parse_command(payload, set);
+using Registers = std::vector<fm::RawRegister>;
+
+/// A WTEC register image that knows the init direction (holding 0x0300).
+Registers init_direction(std::uint16_t direction) {
+    return {fm::RawRegister{fe::Table::holding, 0x0204, 40}, fm::RawRegister{fe::Table::holding, 0x0300, direction}};
+}
+
+std::vector<fp::Request> requests(const std::string& payload, fm::CommandSet set, const Registers& registers = {}) {
+    const auto result = fm::parse_command(payload, set, registers);
     if (const auto* error = std::get_if<fm::CommandError>(&result)) {
         FAIL_CHECK("refused: " << error->message);
         return {};
@@ -19,8 +26,8 @@ std::vector<fp::Request> requests(const std::string& payload, fm::CommandSet set
     return std::get<fm::ParsedCommand>(result).requests;
 }
 
-fm::CommandError refused(const std::string& payload, fm::CommandSet set) {
-    const auto result = fm::parse_command(payload, set);
+fm::CommandError refused(const std::string& payload, fm::CommandSet set, const Registers& registers = {}) {
+    const auto result = fm::parse_command(payload, set, registers);
     REQUIRE(std::holds_alternative<fm::CommandError>(result));
     return std::get<fm::CommandError>(result);
 }
@@ -62,14 +69,53 @@ TEST_CASE("commands: EXCD203MB ops, 32-bit values high word first") {
 TEST_CASE("commands: WTEC ops on the uniform map") {
     using fm::CommandSet;
     CHECK(requests(R"({"id":1,"op":"init"})", CommandSet::wtec) == Rs{fc06(0x0100, 1)});
-    CHECK(requests(R"({"id":1,"op":"grip"})", CommandSet::wtec) == Rs{fc06(0x0105, 0)});
-    CHECK(requests(R"({"id":1,"op":"grip","force_pct":50,"speed_pct":80})", CommandSet::wtec) ==
-          Rs{fc06(0x0103, 50), fc06(0x0104, 80), fc06(0x0105, 0)});
-    CHECK(requests(R"({"id":1,"op":"release","speed_pct":30})", CommandSet::wtec) == Rs{fc06(0x0104, 30), fc06(0x0105, 100)});
     CHECK(requests(R"({"id":1,"op":"position","percent":40})", CommandSet::wtec) == Rs{fc06(0x0105, 40)});
     CHECK(requests(R"({"id":1,"op":"force","percent":20})", CommandSet::wtec) == Rs{fc06(0x0103, 20)});
     CHECK(requests(R"({"id":1,"op":"speed","percent":100})", CommandSet::wtec) == Rs{fc06(0x0104, 100)});
     CHECK(requests(R"({"id":1,"op":"estop"})", CommandSet::wtec) == Rs{fc06(0x0102, 1)});
+}
+
+TEST_CASE("commands: WTEC grip closes and release opens, whichever end the gripper homes to") {
+    using fm::CommandSet;
+    // Init direction 1 (the default): homes at the open end, so 0 % is open, 100 % closed.
+    const Registers open_home = init_direction(1);
+    CHECK(requests(R"({"id":1,"op":"grip"})", CommandSet::wtec, open_home) == Rs{fc06(0x0105, 100)});
+    CHECK(requests(R"({"id":1,"op":"grip","force_pct":50,"speed_pct":80})", CommandSet::wtec, open_home) ==
+          Rs{fc06(0x0103, 50), fc06(0x0104, 80), fc06(0x0105, 100)});
+    CHECK(requests(R"({"id":1,"op":"release","speed_pct":30})", CommandSet::wtec, open_home) ==
+          Rs{fc06(0x0104, 30), fc06(0x0105, 0)});
+    // Init direction 2: homes at the closed end, so 0 % is closed, 100 % open.
+    const Registers closed_home = init_direction(2);
+    CHECK(requests(R"({"id":1,"op":"grip"})", CommandSet::wtec, closed_home) == Rs{fc06(0x0105, 0)});
+    CHECK(requests(R"({"id":1,"op":"release","force_pct":20})", CommandSet::wtec, closed_home) ==
+          Rs{fc06(0x0103, 20), fc06(0x0105, 100)});
+    // 0x0300 of another table (an XEG's position input register) is not the direction.
+    const Registers other_table{fm::RawRegister{fe::Table::input, 0x0300, 1}};
+    CHECK(refused(R"({"id":1,"op":"grip"})", CommandSet::wtec, other_table).kind ==
+          fm::CommandErrorKind::state_unknown);
+}
+
+TEST_CASE("commands: WTEC grip / release before the init direction is known send nothing") {
+    using fm::CommandSet;
+    for (const char* op : {"grip", "release"}) {
+        INFO(op);
+        const auto unknown = refused(std::string(R"({"id":"g1","op":")") + op + R"("})", CommandSet::wtec);
+        CHECK(unknown.kind == fm::CommandErrorKind::state_unknown);
+        CHECK(fm::to_string(unknown.kind) == "state_unknown");
+        CHECK(unknown.id == "g1");
+        CHECK(unknown.op == op);
+        CHECK(unknown.message.find("init direction") != std::string::npos);
+        CHECK(unknown.message.find("not read") != std::string::npos);
+        CHECK(unknown.message.find("retry") != std::string::npos);
+        CHECK(unknown.message.find("'position'") != std::string::npos);
+        // A mode the uniform view shows raw (neither FC nor FD) is no direction either.
+        const auto odd = refused(std::string(R"({"id":"g2","op":")") + op + R"("})", CommandSet::wtec,
+                                 init_direction(0xFE));
+        CHECK(odd.kind == fm::CommandErrorKind::state_unknown);
+        CHECK(odd.message.find("254") != std::string::npos);
+    }
+    // Ops that do not depend on the direction need no registers.
+    CHECK(requests(R"({"id":1,"op":"position","percent":0})", CommandSet::wtec) == Rs{fc06(0x0105, 0)});
 }
 
 TEST_CASE("commands: R6 ops (seed 004 3.2.1, 3.2.2, 3.3.3)") {
@@ -154,7 +200,8 @@ TEST_CASE("commands: what the parser lets through, the device's profile still ch
         CHECK_FALSE(excd->validate(r, image));
     }
     const auto wtec = fe::make_profile(fe::DeviceType::wtec_rtu, fe::ProfileOptions{});
-    for (const auto& r : requests(R"({"id":1,"op":"grip","force_pct":50,"speed_pct":80})", fm::CommandSet::wtec)) {
+    for (const auto& r :
+         requests(R"({"id":1,"op":"grip","force_pct":50,"speed_pct":80})", fm::CommandSet::wtec, init_direction(1))) {
         CHECK_FALSE(wtec->validate(r, image));
     }
     CHECK(fm::command_ops(fm::CommandSet::generic) == std::vector<std::string_view>{"set_register", "write_registers"});

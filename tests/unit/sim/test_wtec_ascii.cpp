@@ -110,11 +110,14 @@ TEST_CASE("wtec-ascii: D moves in position mode, E grips and releases, a release
     clock.advance_ms(200);
     CHECK(running(wtec, clock.now()) == wtec::RunningValues{10000, 3, true, wtec::grip_state::reached});
 
-    // Grip an object 25 % wide: contact at 15000 counts, holding at the peak current.
+    // Grip an object 25 % wide: contact at 15000 counts, holding at the grip current
+    // (the N max current, which C sets).
     REQUIRE(wtec.control("object 25", clock.now()).empty());
+    REQUIRE(!exchange_ascii(wtec, body(1, wtec::SetPeakCurrent{0x3C}), clock.now()).empty());
+    CHECK(wtec.gripper().gripper_params().max_current == 0x3C);  // what `N` reads
     REQUIRE(exchange_ascii(wtec, body(1, wtec::GripperAction{wtec::GripAction::grip}), clock.now()) == ">01EA0D9");
     clock.advance_ms(50);
-    CHECK(running(wtec, clock.now()).current == 0x3C);  // closing at the C current
+    CHECK(running(wtec, clock.now()).current == 0x3C);  // closing at the grip current
     clock.advance_s(1);
     CHECK(running(wtec, clock.now()) == wtec::RunningValues{15000, 0x3C, true, wtec::grip_state::gripped});
 

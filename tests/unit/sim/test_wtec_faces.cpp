@@ -88,9 +88,12 @@ TEST_CASE("wtec: the same scenario through the RTU face and the ASCII face") {
     auto params = std::get<wtec::GripperParams>(ask(ascii_face, wtec::ReadGripper{}, clock.now()));
     params.speed = 128;  // 50 % of 0xFF, rounded
     (void)ask(ascii_face, wtec::WriteGripper{params}, clock.now());
+    // Both set the one grip current, the N max current: 80 % of R's max 0x3F = 50.
     REQUIRE(write_registers(rtu_face, 1, 0x0103, {80}, clock.now(), true) == "06 01 03 00 50");
-    (void)ask(ascii_face, wtec::SetPeakCurrent{50}, clock.now());  // 80 % of 0x3F
-    CHECK(rtu_face.gripper().peak_current() == ascii_face.gripper().peak_current());
+    (void)ask(ascii_face, wtec::SetPeakCurrent{50}, clock.now());
+    CHECK(rtu_face.gripper().grip_current() == 50);
+    CHECK(std::get<wtec::GripperParams>(ask(ascii_face, wtec::ReadGripper{}, clock.now())).max_current == 50);
+    CHECK(read_registers(rtu_face, 1, 0x03, 0x0103, 1, clock.now()).at(0) == ascii_face.gripper().force_percent());
     CHECK(read_registers(rtu_face, 1, 0x03, 0x0104, 1, clock.now()).at(0) ==
           ascii_face.gripper().speed_percent());
 

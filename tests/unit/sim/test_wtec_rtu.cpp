@@ -29,10 +29,14 @@ TEST_CASE("wtec-rtu: manual examples byte for byte, in a working order") {
     clock.advance_ms(300);
     CHECK(reg(wtec, 0x0200, clock.now()) == 1);
     CHECK(reg(wtec, 0x0202, clock.now()) == 1);
-    // Force 80 %, then 100 %; the reads ("xx xx" in the manual) return them.
+    // Force 80 %, then 100 % (the reads are "xx xx" in the manual). Force is the N max
+    // (grip) current over R's max current 0x3F: 80 % sets N max = round(50.4) = 50,
+    // which reads round(5000 / 63) = 79 %; 100 % sets 63 and reads 100 %.
     CHECK(exchange(wtec, hex("01 06 01 03 00 50 78 0A"), clock.now()) == "01 06 01 03 00 50 78 0A");
-    CHECK(exchange(wtec, hex("01 03 01 03 00 01 75 F6"), clock.now()) == hex_of(rtu("01 03 02 00 50")));
+    CHECK(wtec.gripper().gripper_params().max_current == 50);
+    CHECK(exchange(wtec, hex("01 03 01 03 00 01 75 F6"), clock.now()) == hex_of(rtu("01 03 02 00 4F")));
     CHECK(exchange(wtec, hex("01 06 01 03 00 64 79 DD"), clock.now()) == "01 06 01 03 00 64 79 DD");
+    CHECK(wtec.gripper().gripper_params().max_current == 0x3F);
     CHECK(reg(wtec, 0x0103, clock.now()) == 100);
     // Position 50, read back the set position, follow the instant position.
     CHECK(exchange(wtec, hex("01 06 01 05 00 32 19 E2"), clock.now()) == "01 06 01 05 00 32 19 E2");
