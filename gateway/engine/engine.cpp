@@ -44,7 +44,7 @@ Engine::Engine(asio::io_context& io, const config::Config& config, LogSink log, 
             } catch (const ProfileError& error) {
                 throw ProfileError(fmt::format("line {}, device {}: {}", line.name, device.name, error.what()));
             }
-            entry.worker->scheduler().add_device(index, device_limits(line, device));
+            entry.worker->scheduler().add_device(index, device_limits(line, device), device.name);
             LineWorker* worker = entry.worker.get();
             entry.agents.push_back(std::make_unique<DeviceAgent>(
                 io, device_agent_config(line, device, index), std::move(profile),

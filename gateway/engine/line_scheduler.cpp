@@ -56,7 +56,7 @@ struct LineScheduler::Rank {
 LineScheduler::LineScheduler(SchedulerConfig config, LogSink log)
     : config_(std::move(config)), log_(std::move(log)) {}
 
-void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits) {
+void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits, std::string name) {
     const std::string where = "line " + config_.line_name + " device " + std::to_string(device);
     if (device == broadcast_device) {
         throw std::invalid_argument(where + ": index is reserved for broadcasts");
@@ -71,6 +71,7 @@ void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits) {
     }
     Device state;
     state.limits = limits;
+    state.name = std::move(name);
     state.backoff = limits.backoff_initial;
     devices_.emplace(device, std::move(state));
 }
@@ -87,6 +88,9 @@ const LineScheduler::Device* LineScheduler::find(DeviceIndex device) const noexc
 
 std::string LineScheduler::describe(DeviceIndex device) const {
     if (device == broadcast_device) return "line " + config_.line_name + " broadcast";
+    if (const Device* known = find(device); known != nullptr && !known->name.empty()) {
+        return "line " + config_.line_name + " device '" + known->name + "'";
+    }
     return "line " + config_.line_name + " device " + std::to_string(device);
 }
 

@@ -122,8 +122,9 @@ public:
 
     /// Registers a device (online, empty queue). Throws std::invalid_argument for a
     /// duplicate index, broadcast_device, or limits that cannot work (queue_limit 0,
-    /// offline_after 0, back-off not positive or max below initial).
-    void add_device(DeviceIndex device, DeviceLimits limits);
+    /// offline_after 0, back-off not positive or max below initial). @p name (the
+    /// device's config name) is what the scheduler's log messages call it.
+    void add_device(DeviceIndex device, DeviceLimits limits, std::string name = {});
     void set_health_callback(HealthCallback callback) { on_health_ = std::move(callback); }
 
     /// Queues @p transaction (sets id and enqueued), or completes it at once:
@@ -176,6 +177,7 @@ private:
     };
     struct Device {
         DeviceLimits limits;
+        std::string name;  ///< for log messages; empty: called by its index
         std::vector<Entry> queue;  ///< unordered: next() ranks every entry
         bool online = true;
         unsigned consecutive_timeouts = 0;

@@ -264,6 +264,22 @@ TEST_CASE("scheduler: a write that timed out is never retried, even if flagged r
     CHECK(logs[0].find("line A device 0") != std::string::npos);
 }
 
+TEST_CASE("scheduler: log messages name a device by its config name when it has one") {
+    std::vector<std::string> logs;
+    Recorder r;
+    fe::LineScheduler logged({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
+                                                    if (level == fe::LogLevel::warning) logs.emplace_back(m);
+                                                },
+                                                fe::LogLevel::info});
+    fe::DeviceLimits limits;
+    limits.offline_after = 1;
+    logged.add_device(0, limits, "gripper-left");
+    logged.submit(tagged(read_tx(0, 1, Priority::poll), r, "poll"), t0);
+    run_next(logged, t0, OutcomeStatus::timeout);
+    REQUIRE_FALSE(logs.empty());
+    CHECK(logs.back().find("line A device 'gripper-left': offline after 1 consecutive timeouts") == 0);
+}
+
 TEST_CASE("scheduler: polls age into the on-demand class and are not starved by reads") {
     auto s = make_scheduler(2);
     Recorder r;
