@@ -199,6 +199,11 @@ LineAction LineMaster::next_action(TimePoint now) {
     return line_action::Idle{};
 }
 
+TimePoint LineMaster::reply_decision_at() const noexcept {
+    if (!rx_.empty()) return std::min(last_rx_ + gap_limit_, hard_deadline_);
+    return reply_deadline_;
+}
+
 LineAction LineMaster::wait_for_reply(TimePoint now) {
     const bool receiving = state_ == MasterState::awaiting_reply && !rx_.empty();
     if (receiving && now >= last_rx_ + gap_limit_) {
@@ -210,8 +215,7 @@ LineAction LineMaster::wait_for_reply(TimePoint now) {
         finish(OutcomeStatus::timeout, {}, now, "no valid reply in time");
         return hand_out(now);
     }
-    if (!rx_.empty()) return line_action::Wait{std::min(last_rx_ + gap_limit_, hard_deadline_)};
-    return line_action::Wait{reply_deadline_};
+    return line_action::Wait{reply_decision_at()};
 }
 
 void LineMaster::on_written(TimePoint now) {

@@ -119,6 +119,10 @@ public:
     [[nodiscard]] MasterState state() const noexcept { return state_; }
     /// The earliest time the current (or a next) request may be written.
     [[nodiscard]] TimePoint earliest_send() const noexcept;
+    /// While a reply is awaited: the earliest time next_action() may decide without
+    /// new bytes (a partial frame's gap expired, or a timeout). Before it, reading the
+    /// port first cannot change what next_action() returns.
+    [[nodiscard]] TimePoint reply_decision_at() const noexcept;
     [[nodiscard]] const LineCounters& counters() const noexcept { return counters_; }
     /// start -> finished, for transactions that went on the wire.
     [[nodiscard]] const LatencyHistogram& latency() const noexcept { return latency_; }

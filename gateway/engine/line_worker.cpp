@@ -1,5 +1,7 @@
 #include "engine/line_worker.hpp"
 
+#include <sys/prctl.h>
+
 #include <asio/error.hpp>
 #include <asio/post.hpp>
 #include <asio/steady_timer.hpp>
@@ -73,6 +75,10 @@ public:
         if (stopped_) throw std::logic_error("line " + config_.name + ": start() after stop()");
         if (started_) return;
         started_ = true;
+        // The loop thread times silences of a few hundred microseconds: the default
+        // timer slack (50 us) would add up to that to every wake-up (spec section 9,
+        // docs/performance.md). Per thread; harmless for the rest of the loop.
+        ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
         try_open();
     }
 
@@ -154,15 +160,25 @@ private:
     /// Runs the scheduler and the master until they must wait for the port or a time.
     /// Everything that may call back into user code (submissions, finished) is
     /// followed by a fresh look at the state, because a completion may submit or stop.
-    void drive() {
+    ///
+    /// @p polled: called from the port's readiness handler or the wake timer, i.e.
+    /// right after the reactor looked at the port. asio completes the descriptors
+    /// ready in one reactor pass before the timers of that pass, so any byte that had
+    /// arrived by then was read already: the port need not be read again before a
+    /// write or a timeout decision (one read syscall less per transaction; the window
+    /// left is the few microseconds of this handler, as with a read). A drive posted
+    /// by a submission may run before a pending readiness handler: it reads first.
+    void drive(bool polled = false) {
         if (in_drive_) return;
         in_drive_ = true;
         unsigned idle_rechecks = 0;
         while (true) {
+            if (!inbox_.empty()) polled = false;  // submissions may complete user code now
             take_inbox();
             if (stopped_ || !port_.is_open()) break;
             TimePoint now = Clock::now();
             if (!master_.busy()) {
+                polled = false;  // next() may complete expired transactions
                 std::optional<Transaction> next = scheduler_.next(now);
                 if (stopped_ || !port_.is_open()) {
                     if (next) complete_now(*next, OutcomeStatus::cancelled, now);
@@ -174,13 +190,14 @@ private:
                     continue;
                 }
             }
-            if (master_.state() == MasterState::waiting_silence && now >= master_.earliest_send()) {
+            if (!polled && master_.state() == MasterState::waiting_silence && now >= master_.earliest_send()) {
                 // About to write: take in what arrived meanwhile first, so that bytes
                 // queued behind a pending readiness event still push the silence out.
                 if (!read_input()) continue;
                 now = Clock::now();
             }
-            if (master_.state() == MasterState::awaiting_reply || master_.state() == MasterState::discarding_echo) {
+            if ((master_.state() == MasterState::awaiting_reply || master_.state() == MasterState::discarding_echo) &&
+                now >= master_.reply_decision_at()) {
                 // next_action() decides the timeout: take in what arrived first. A drive
                 // posted by a submission can run before the port's readiness handler when
                 // the loop was held up (a slow handler, a busy machine); without this a
@@ -189,6 +206,7 @@ private:
                 if (!read_input()) continue;
                 now = Clock::now();
             }
+            polled = false;  // what follows may run user code (completions) for a while
             LineAction action = master_.next_action(now);
             if (auto* finished = std::get_if<line_action::Finished>(&action)) {
                 scheduler_.finished(std::move(finished->transaction), finished->outcome, now);
@@ -249,7 +267,7 @@ private:
         wake_timer_.async_wait(guarded([this, generation](const asio::error_code& error) {
             if (error == asio::error::operation_aborted || generation != wake_generation_) return;
             wake_at_.reset();
-            drive();
+            drive(true);
         }));
     }
 
@@ -303,7 +321,7 @@ private:
                 return;
             }
             arm_readable();
-            drive();
+            drive(true);
         }));
     }
 

@@ -93,6 +93,24 @@ TEST_CASE("master: no reply times out at end of transmission + response_timeout"
     CHECK(master.counters().replies == 0);
 }
 
+TEST_CASE("master: reply_decision_at is when the wait for a reply can end without new bytes") {
+    auto master = make_master();
+    TimePoint written;
+    send(master, read_model(), t0, written);
+    const TimePoint deadline = written + master.timing().wire_time(8) + 100ms;
+    // Nothing received: the response timeout; before it next_action() only waits.
+    CHECK(master.reply_decision_at() == deadline);
+    CHECK(expect_wait(master, deadline - 1ms) == master.reply_decision_at());
+    // Part of a reply: the byte timeout after its last byte (5 ms by default).
+    const TimePoint first = written + master.timing().wire_time(8) + 1ms;
+    master.on_bytes(fp::ByteView(read_model_reply).first(3), first);
+    CHECK(master.reply_decision_at() == first + 5ms);
+    CHECK(expect_wait(master, first + 1ms) == master.reply_decision_at());
+    // The gap passed: the partial frame is dropped, the wait goes on to the timeout.
+    CHECK(expect_wait(master, first + 5ms) == deadline);
+    CHECK(master.reply_decision_at() == deadline);
+}
+
 TEST_CASE("master: the next request waits for the turnaround guard after a reply") {
     fe::LineTimingConfig config;
     config.turnaround = 1ms;

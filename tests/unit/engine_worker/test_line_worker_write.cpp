@@ -39,6 +39,7 @@ public:
         return static_cast<std::size_t>(n);
     }
     [[nodiscard]] std::size_t read_some(std::span<std::uint8_t> buffer) override {
+        ++read_calls;
         const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT);
         if (n > 0) return static_cast<std::size_t>(n);
         if (n == 0) throw fe::SerialPortError("chunked: peer closed");
@@ -51,6 +52,7 @@ public:
     /// The device's end of the line.
     [[nodiscard]] int peer() const { return peer_; }
     std::size_t write_calls = 0;
+    std::size_t read_calls = 0;  ///< including those that found nothing
 
 private:
     std::size_t chunk_;
@@ -95,6 +97,49 @@ TEST_CASE("worker: a request the driver takes in pieces goes out whole, then the
     REQUIRE(run_until(io, [&] { return recorder.total() == 1; }));
     CHECK(recorder.status("fc16") == OutcomeStatus::ok);
     CHECK(recorder.outcome("fc16").attempts == 1);
+    worker.stop();
+}
+
+TEST_CASE("worker: back-to-back transactions read the port about once each, not before every decision") {
+    // The worker reads when the reactor reports the port readable. Right after such a
+    // report (readiness or wake timer), reading again before the write or before
+    // judging a timeout cannot find anything new: it would cost a system call per
+    // transaction for nothing (docs/performance.md). 8 transactions with whole
+    // replies: one read each, plus a few for the start and the posted submissions.
+    asio::io_context io;
+    auto owned = std::make_unique<ChunkedPort>(256);
+    ChunkedPort& port = *owned;
+    fe::LineWorkerConfig config;
+    config.name = "W";
+    fe::LineWorker worker(io, config, std::move(owned));
+    worker.scheduler().add_device(0, fe::DeviceLimits{});
+    worker.start();
+    REQUIRE(worker.line_up());
+
+    Recorder recorder;
+    constexpr int transactions = 8;
+    for (int i = 0; i < transactions; ++i) {
+        worker.submit(tagged(read_tx(1, Priority::on_demand), recorder, "read" + std::to_string(i)));
+    }
+    const std::size_t reads_before = port.read_calls;
+    std::size_t answered = 0;
+    REQUIRE(run_until(io, [&] {
+        std::array<std::uint8_t, 64> buffer{};
+        const ssize_t n = ::recv(port.peer(), buffer.data(), buffer.size(), MSG_DONTWAIT);
+        if (n == 8) {  // one whole request: answer it whole
+            const Bytes reply =
+                fp::encode_rtu(1, fp::encode_response(fp::ReadRegistersResponse{fp::fc::read_holding_registers, {7, 8}}));
+            REQUIRE(::send(port.peer(), reply.data(), reply.size(), 0) == static_cast<ssize_t>(reply.size()));
+            ++answered;
+        }
+        return recorder.total() == transactions;
+    }));
+    CHECK(answered == transactions);
+    for (int i = 0; i < transactions; ++i) CHECK(recorder.status("read" + std::to_string(i)) == OutcomeStatus::ok);
+    const std::size_t reads = port.read_calls - reads_before;
+    INFO("read_some calls for " << transactions << " transactions: " << reads);
+    CHECK(reads >= transactions);
+    CHECK(reads <= transactions + 4);
     worker.stop();
 }
 
