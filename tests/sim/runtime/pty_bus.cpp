@@ -143,7 +143,9 @@ void PtyBus::arm_timers() {
     if (next != output_armed_) {
         output_armed_ = next;
         if (next) {
-            output_timer_.expires_at(*next);
+            // Wire time: wake early and spin the rest (on_output_timer), so a reply
+            // leaves when the emulated line says, not when the scheduler wakes us.
+            output_timer_.expires_at(engine_->settings().wire_time ? *next - output_spin_lead : *next);
             output_timer_.async_wait([this](const asio::error_code& e) { on_output_timer(e); });
         } else {
             output_timer_.cancel();
@@ -166,6 +168,11 @@ void PtyBus::on_output_timer(const asio::error_code& error) {
         return;
     }
     output_armed_.reset();
+    if (const auto due = engine_->next_output(); due && engine_->settings().wire_time) {
+        while (Clock::now() < *due) {
+            // A real UART starts shifting at its instant; at most output_spin_lead.
+        }
+    }
     try {
         flush_due();
     } catch (const std::exception& e) {

@@ -22,6 +22,12 @@
 
 namespace fieldbridge::sim::runtime {
 
+/// With wire time on, the output timer fires this much before a reply is due and the
+/// bus spins to the exact instant: a timer wake-up on a virtual machine is often
+/// 50-150 us late, which would count against the gateway in the benchmarks
+/// (docs/simulator.md, "Wire-time precision"). Costs at most this much CPU per reply.
+inline constexpr std::chrono::microseconds output_spin_lead{250};
+
 class PtyBus {
 public:
     PtyBus(asio::io_context& io, std::filesystem::path link, std::unique_ptr<BusEngine> engine,
