@@ -8,7 +8,11 @@
 //      (max_age 0), completed transactions/s against 1 / T_line;
 //   b. command latency: the same saturating reads plus one FC16 write every
 //      30-50 ms (random phase), submit -> answer latency against the priority ideal;
-//   c. CPU per serial transaction: getrusage(RUSAGE_SELF) over run (a).
+//   c. CPU per serial transaction: getrusage(RUSAGE_SELF) over run (a), user and
+//      kernel time apart;
+//   0. first, the floor: the same reads from a minimal master on raw system calls
+//      (raw_master.hpp) against the same simulator, for the same time: what this
+//      machine, its pseudo-terminals and the simulator allow at best.
 //
 // The simulator binary is named by FIELDBRIDGE_SIM (run-benchmarks sets it); it is a
 // separate process, so the CPU figure is the gateway side alone (engine, scheduler,
@@ -30,6 +34,7 @@
 #include <fmt/format.h>
 
 #include "engine/line_timing.hpp"
+#include "raw_master.hpp"
 #include "engine_harness.hpp"
 #include "sim_process.hpp"
 
@@ -52,13 +57,18 @@ constexpr std::size_t read_reply_bytes = 9;
 constexpr std::size_t write_request_bytes = 11;
 constexpr std::size_t write_reply_bytes = 8;
 
-double cpu_seconds() {
+struct CpuTimes {
+    double user = 0.0;
+    double sys = 0.0;
+};
+
+CpuTimes cpu_times() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     const auto to_seconds = [](const timeval& tv) {
         return static_cast<double>(tv.tv_sec) + static_cast<double>(tv.tv_usec) / 1e6;
     };
-    return to_seconds(usage.ru_utime) + to_seconds(usage.ru_stime);
+    return {to_seconds(usage.ru_utime), to_seconds(usage.ru_stime)};
 }
 
 double ms(Clock::duration d) { return duration<double, std::milli>(d).count(); }
@@ -135,6 +145,18 @@ int run(double run_seconds, int write_count) {
     const double limit_tps = 1000.0 / t_read;
 
     SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--wire-time", "--baud", "115200", "--turnaround", "1ms"});
+
+    // ---- 0: the floor ---------------------------------------------------------------
+    const bench::RawMasterResult floor =
+        bench::run_raw_master(sim.path("line-a"), 2, status_address, duration<double>(run_seconds));
+    const double floor_tps = static_cast<double>(floor.transactions) / floor.seconds;
+    const double floor_cpu = floor.user_cpu_us + floor.sys_cpu_us;
+    std::printf("== fb_bench_line (0) floor: minimal raw-syscall master, same reads, same simulator ==\n");
+    std::printf("floor: %llu reads in %.3f s = %.1f tx/s, ratio %.3f; %llu timeouts; CPU %.1f us/transaction "
+                "(user %.1f + kernel %.1f)\n",
+                static_cast<unsigned long long>(floor.transactions), floor.seconds, floor_tps, floor_tps / limit_tps,
+                static_cast<unsigned long long>(floor.timeouts), floor_cpu, floor.user_cpu_us, floor.sys_cpu_us);
+
     EngineHarness h(engine_yaml(sim.path("line-a")));
     h.start();
     auto& xeg = h.device("xeg");
@@ -149,24 +171,28 @@ int run(double run_seconds, int write_count) {
     h.run_for(milliseconds{500});  // warm-up
     const auto bus0 = sim.stats()["buses"]["line-a"];
     const std::uint64_t done0 = reads.completed();
-    const double cpu0 = cpu_seconds();
+    const CpuTimes cpu0 = cpu_times();
     const auto t0 = Clock::now();
     h.run_for(std::chrono::duration_cast<engine::Duration>(duration<double>(run_seconds)));
     const auto t1 = Clock::now();
-    const double cpu1 = cpu_seconds();
+    const CpuTimes cpu1 = cpu_times();
     const std::uint64_t done1 = reads.completed();
     const auto bus1 = sim.stats()["buses"]["line-a"];
 
     const double elapsed = duration<double>(t1 - t0).count();
     const auto transactions = static_cast<double>(done1 - done0);
     const double tps = transactions / elapsed;
-    const double cpu_us = (cpu1 - cpu0) * 1e6 / transactions;
+    const double user_us = (cpu1.user - cpu0.user) * 1e6 / transactions;
+    const double sys_us = (cpu1.sys - cpu0.sys) * 1e6 / transactions;
+    const double cpu_us = user_us + sys_us;
     const auto counter = [](const nlohmann::json& bus, const char* name) { return bus.value(name, std::uint64_t{0}); };
 
     std::printf("== fb_bench_line (a) line utilisation: 16 on-demand FC04 0x0300 x2 reads outstanding ==\n");
     std::printf("T_line (8 + 9 bytes, 115200 8N1, 1 ms turnaround) = %.3f ms -> limit %.1f tx/s\n", t_read, limit_tps);
-    std::printf("completed %.0f reads in %.3f s = %.1f tx/s, ratio %.3f (target >= 0.95); failed %llu\n", transactions,
-                elapsed, tps, tps / limit_tps, static_cast<unsigned long long>(reads.failed()));
+    std::printf("completed %.0f reads in %.3f s = %.1f tx/s, ratio %.3f (target >= 0.95); failed %llu; "
+                "%.3f of the floor's rate\n",
+                transactions, elapsed, tps, tps / limit_tps, static_cast<unsigned long long>(reads.failed()),
+                floor_tps > 0.0 ? tps / floor_tps : 0.0);
     std::printf("simulator: %llu requests, %llu replies in the window; gap_violations total %llu (target 0), "
                 "min_silence_us %s, collisions %llu, utilization %s\n",
                 static_cast<unsigned long long>(counter(bus1, "requests") - counter(bus0, "requests")),
@@ -181,8 +207,10 @@ int run(double run_seconds, int write_count) {
     std::printf("mean line time per transaction %.3f ms = T_line + %.3f ms; simulator reply lateness %s\n",
                 per_tx_ms, per_tx_ms - t_read, bus1.contains("timing") ? bus1["timing"].dump().c_str() : "?");
     std::printf("== fb_bench_line (c) CPU per serial transaction ==\n");
-    std::printf("process CPU (user+sys) %.3f s over %.0f transactions = %.1f us/transaction (target <= 50)\n",
-                cpu1 - cpu0, transactions, cpu_us);
+    std::printf("process CPU (user+sys) %.3f s over %.0f transactions = %.1f us/transaction (target <= 50): "
+                "user %.1f + kernel %.1f; %.2fx the floor's %.1f us\n",
+                (cpu1.user - cpu0.user) + (cpu1.sys - cpu0.sys), transactions, cpu_us, user_us, sys_us,
+                floor_cpu > 0.0 ? cpu_us / floor_cpu : 0.0, floor_cpu);
 
     // ---- b: command latency under saturating reads --------------------------------
     std::vector<double> latencies;

@@ -13,10 +13,15 @@
 //      max_age 0: every read goes to the line): transactions/s against 1 / T_line.
 //
 // Clients and daemon share the machine's cores: the figures include that contention.
+// The client threads run at nice 10: they stand for other machines, and at nice 0 the
+// 32 of them starve the device simulator (which stands for hardware with its own
+// CPU) until its replies come later than the 100 ms response timeout and the device
+// goes offline. The daemon and the simulator run at the default priority.
 // Not a test: it prints figures and asserts nothing.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -29,6 +34,7 @@
 #include <exception>
 #include <fstream>
 #include <stdexcept>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -67,6 +73,7 @@ std::uint16_t free_port() {
 struct ClientResult {
     std::vector<double> latency_us;  ///< requests sent inside the window
     std::uint64_t errors = 0;        ///< exceptions, short reads, timeouts
+    std::array<std::uint64_t, 256> exceptions{};  ///< exception replies by code
     std::string failure;             ///< why the client stopped early, if it did
 };
 
@@ -84,6 +91,8 @@ bool read_exactly(int fd, std::uint8_t* data, std::size_t size) {
 /// @p stop; latencies recorded for requests sent in [window_start, window_end).
 void run_client(std::uint16_t port, std::uint8_t unit, const std::atomic<bool>& stop, Clock::time_point window_start,
                 Clock::time_point window_end, ClientResult& result) {
+    // Linux: a thread's nice value is its own (setpriority on the thread id).
+    static_cast<void>(setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10));
     const int fd = socket(AF_INET, SOCK_STREAM, 0);
     const int one = 1;
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
@@ -124,6 +133,7 @@ void run_client(std::uint16_t port, std::uint8_t unit, const std::atomic<bool>& 
         const auto answered = Clock::now();
         const bool ok = reply[7] == 0x04 && rest == 6;
         if (!ok) ++result.errors;
+        if (reply[7] == 0x84 && rest == 2) ++result.exceptions[reply[8]];
         if (ok && sent >= window_start && sent < window_end) {
             result.latency_us.push_back(duration<double, std::micro>(answered - sent).count());
         }
@@ -135,11 +145,30 @@ struct LoadFigures {
     double seconds = 0.0;
     std::uint64_t reads = 0;
     std::uint64_t errors = 0;
+    std::string exceptions;  ///< "0x0B x 12, ..." or empty
     double p50_us = 0.0;
     double p99_us = 0.0;
     double max_us = 0.0;
     std::string failures;
 };
+
+/// The daemon's warnings and errors so far (the first few): a benchmark figure that
+/// looks wrong usually has its reason there (timeouts, a device gone offline).
+void print_warnings(const std::string& log, const char* when) {
+    std::istringstream lines(log);
+    std::string line;
+    int shown = 0;
+    int total = 0;
+    while (std::getline(lines, line)) {
+        if (line.find("[warning]") == std::string::npos && line.find("[error]") == std::string::npos) continue;
+        ++total;
+        if (shown < 5) {
+            std::printf("daemon log %s: %s\n", when, line.c_str());
+            ++shown;
+        }
+    }
+    if (total > shown) std::printf("daemon log %s: ... %d warnings/errors in all\n", when, total);
+}
 
 double percentile(const std::vector<double>& sorted, double p) {
     if (sorted.empty()) return 0.0;
@@ -169,10 +198,17 @@ LoadFigures run_load(std::uint16_t port, std::uint8_t unit, unsigned clients, do
     LoadFigures figures;
     figures.seconds = seconds;
     std::vector<double> all;
+    std::array<std::uint64_t, 256> exceptions{};
     for (const auto& result : results) {
         all.insert(all.end(), result.latency_us.begin(), result.latency_us.end());
         figures.errors += result.errors;
+        for (std::size_t code = 0; code < exceptions.size(); ++code) exceptions[code] += result.exceptions[code];
         if (!result.failure.empty()) figures.failures += result.failure + "; ";
+    }
+    for (std::size_t code = 0; code < exceptions.size(); ++code) {
+        if (exceptions[code] == 0) continue;
+        if (!figures.exceptions.empty()) figures.exceptions += ", ";
+        figures.exceptions += fmt::format("0x{:02X} x {}", code, exceptions[code]);
     }
     std::sort(all.begin(), all.end());
     figures.reads = all.size();
@@ -256,6 +292,7 @@ int run(const std::string& daemon_binary, double seconds) {
                 static_cast<unsigned long long>(cached.reads), cached.seconds, cached_rate,
                 static_cast<unsigned long long>(cached.errors), cached.failures.empty() ? "" : "; client failures: ",
                 cached.failures.c_str());
+    if (!cached.exceptions.empty()) std::printf("exception replies: %s\n", cached.exceptions.c_str());
     std::printf("latency p50 %.0f us, p99 %.0f us (target < 1000), max %.0f us\n", cached.p50_us, cached.p99_us,
                 cached.max_us);
     std::printf("serial requests on line-a: %llu during the load (%.1f/s) vs %llu in the idle window before "
@@ -267,6 +304,14 @@ int run(const std::string& daemon_binary, double seconds) {
                 cached_cpu1 - cached_cpu0, cached.seconds, 100.0 * (cached_cpu1 - cached_cpu0) / cached.seconds);
     std::printf("daemon idle CPU (two lines, one polled at 100 ms / 1 s): %.2f%% of one core; RSS %ld KiB\n",
                 100.0 * idle_cpu / idle_elapsed, daemon.rss_kib());
+    print_warnings(daemon.log_text(), "during (1)");
+    {
+        const auto bus = sim.stats()["buses"]["line-a"];
+        std::printf("simulator line-a: %s requests, %s replies, reply lateness %s\n",
+                    bus.value("requests", nlohmann::json(0)).dump().c_str(),
+                    bus.value("replies", nlohmann::json(0)).dump().c_str(),
+                    bus.contains("timing") ? bus["timing"].dump().c_str() : "?");
+    }
 
     // ---- 2: TCP -> line throughput ------------------------------------------------
     const engine::LineTiming timing(engine::CharacterFormat{115200, 8, false, 1});
@@ -289,6 +334,7 @@ int run(const std::string& daemon_binary, double seconds) {
                 static_cast<unsigned long long>(direct.reads), direct.seconds, direct_rate, direct_rate / limit,
                 static_cast<unsigned long long>(direct.errors), direct.failures.empty() ? "" : "; client failures: ",
                 direct.failures.c_str());
+    if (!direct.exceptions.empty()) std::printf("exception replies: %s\n", direct.exceptions.c_str());
     std::printf("simulator line-b requests in the window: %llu = %.1f/s, ratio %.3f\n",
                 static_cast<unsigned long long>(b_requests), static_cast<double>(b_requests) / direct.seconds,
                 static_cast<double>(b_requests) / direct.seconds / limit);

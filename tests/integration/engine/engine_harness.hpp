@@ -67,7 +67,7 @@ public:
     [[nodiscard]] const std::vector<std::string>& warnings() const noexcept { return warnings_; }
 
 private:
-    asio::io_context io_;
+    asio::io_context io_{1};  // one thread, as the daemon runs it (daemon.hpp)
     asio::executor_work_guard<asio::io_context::executor_type> work_;
     std::shared_ptr<const config::Config> config_;
     std::vector<std::string> warnings_;
