@@ -24,7 +24,7 @@ public:
     DaemonProcess& operator=(const DaemonProcess&) = delete;
 
     [[nodiscard]] pid_t pid() const noexcept { return pid_; }
-    /// User + system CPU time the daemon used so far (from /proc/<pid>/stat).
+    /// User + system CPU time the daemon used so far (its process CPU-time clock, ns).
     [[nodiscard]] double cpu_seconds() const;
     /// Resident set size in KiB (VmRSS of /proc/<pid>/status); 0 when unreadable.
     [[nodiscard]] long rss_kib() const;
