@@ -77,7 +77,10 @@ private:
     // ---- device_agent_requests.cpp ----
     void submit_step(const OperationPtr& op);
     void on_step_done(const OperationPtr& op, const Outcome& outcome);
-    void answer(const OperationPtr& op, protocol::Response response);
+    /// How answer() hands a response over: posted to the loop, or (from a line
+    /// completion, never inside request()) called at once.
+    enum class Delivery { posted, now };
+    void answer(const OperationPtr& op, protocol::Response response, Delivery delivery = Delivery::posted);
     void post_answer(ResponseHandler done, protocol::Response response);
 
     // ---- device_agent.cpp ----
@@ -108,6 +111,7 @@ private:
     TimePoint motion_command_done_{};    ///< when the last one finished
     std::set<std::uint32_t> warned_items_;  ///< poll items whose failure was logged
     std::vector<OperationPtr> operations_;  ///< requests not answered yet
+    unsigned in_request_ = 0;               ///< request() calls on the stack
 };
 
 }  // namespace fieldbridge::engine

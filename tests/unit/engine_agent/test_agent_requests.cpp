@@ -185,3 +185,32 @@ TEST_CASE("agent requests: after stop() nothing goes to the line; the client get
     CHECK(rig.last_answer() == exception(fp::fc::read_input_registers, ExceptionCode::gateway_path_unavailable));
     CHECK(rig.line.sent.empty());
 }
+
+TEST_CASE("agent requests: a line answer reaches the client from the line's completion, not a later loop pass") {
+    // The line worker completes a transaction on the loop; the agent hands the answer
+    // over right there, so a client that asks again is queued in the same pass
+    // (docs/performance.md, "CPU per transaction").
+    Rig rig(fe::DeviceType::hiwin_xeg, quiet(0ms));
+    rig.request(fp::ReadRegistersRequest{fp::fc::read_input_registers, 0x0300, 2});
+    REQUIRE(rig.line.sent.size() == 1);
+    rig.line.reply(0, registers_reply(rig.line.at(0), {0, 1}));
+    REQUIRE(rig.answers.got.size() == 1);  // no io.run() in between
+    CHECK(rig.last_answer() == fp::Response{fp::ReadRegistersResponse{fp::fc::read_input_registers, {0, 1}}});
+    // Failures too (0x0B for a read that timed out).
+    rig.request(fp::ReadRegistersRequest{fp::fc::read_input_registers, 0x0300, 2});
+    REQUIRE(rig.line.sent.size() == 2);
+    rig.line.fail(1, fe::OutcomeStatus::timeout);
+    REQUIRE(rig.answers.got.size() == 2);
+    CHECK(rig.last_answer() ==
+          exception(fp::fc::read_input_registers, ExceptionCode::gateway_target_failed));
+}
+
+TEST_CASE("agent requests: a line that completes inside request() still never answers from inside it") {
+    Rig rig(fe::DeviceType::hiwin_xeg, quiet(0ms));
+    rig.line.complete_inline = fe::OutcomeStatus::queue_full;
+    rig.request(fp::ReadRegistersRequest{fp::fc::read_input_registers, 0x0300, 2});
+    REQUIRE(rig.line.sent.size() == 1);
+    CHECK(rig.answers.got.empty());
+    rig.await_answers(1);
+    CHECK(rig.last_answer() == exception(fp::fc::read_input_registers, ExceptionCode::server_device_busy));
+}
