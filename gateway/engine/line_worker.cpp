@@ -18,6 +18,10 @@
 namespace fieldbridge::engine {
 namespace {
 
+/// Waits at least this long go to the lazy timer (LineWorker::Impl::arm_wake): longer
+/// than any silence, gap or turnaround, shorter than any sensible response timeout.
+constexpr Duration lazy_wait = std::chrono::milliseconds{20};
+
 /// "500 ms", "1 s", "2.5 s": for the retry messages an operator reads.
 std::string duration_text(Duration duration) {
     const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(duration).count();
@@ -51,6 +55,7 @@ public:
           scheduler_(scheduler_config(config_), log_),
           port_(io, std::move(port)),
           wake_timer_(io),
+          lazy_timer_(io),
           reopen_timer_(io),
           reopen_delay_(config_.reopen_initial) {
         if (config_.reopen_initial <= Duration::zero() || config_.reopen_max < config_.reopen_initial) {
@@ -109,6 +114,7 @@ public:
         const TimePoint now = Clock::now();
         const bool was_up = line_up_;
         wake_timer_.cancel();
+        lazy_timer_.cancel();
         reopen_timer_.cancel();
         close_port();
         if (auto finished = master_.abort(now)) {
@@ -221,7 +227,7 @@ private:
                 // A deadline already behind us loops at once: a timer would add a trip
                 // through the reactor to every transaction.
                 if (wait->until <= Clock::now()) continue;
-                arm_wake(wait->until);
+                arm_wake(wait->until, now);
                 break;
             }
             // Idle: nothing eligible now.
@@ -231,7 +237,7 @@ private:
             if (*wake <= now && ++idle_rechecks < 3) continue;
             // "Due now" yet nothing to pick would be a scheduler inconsistency: look
             // again in a millisecond rather than spin through the reactor.
-            arm_wake(*wake > now ? *wake : now + std::chrono::milliseconds{1});
+            arm_wake(*wake > now ? *wake : now + std::chrono::milliseconds{1}, now);
             break;
         }
         in_drive_ = false;
@@ -259,7 +265,27 @@ private:
         call_on_done(transaction, outcome, log_, config_.name);
     }
 
-    void arm_wake(TimePoint until) {
+    /// Wakes drive() at @p until (or earlier: drive() always looks again). Short waits
+    /// (silences, gaps, turnarounds) set wake_timer_ to the instant. Long ones (a
+    /// reply's timeout, the next poll) go to lazy_timer_, which is left alone when it
+    /// is already due no later than needed: it then wakes drive() early, once per
+    /// timeout period rather than per transaction, and is set again from there.
+    /// Re-setting a pending timer for every request would cancel its wait (one more
+    /// pass through the reactor) and update the timerfd each time
+    /// (docs/performance.md, "CPU per transaction").
+    void arm_wake(TimePoint until, TimePoint now) {
+        if (until - now >= lazy_wait) {
+            if (lazy_at_ && *lazy_at_ <= until) return;
+            lazy_at_ = until;
+            const std::uint64_t generation = ++lazy_generation_;
+            lazy_timer_.expires_at(until);
+            lazy_timer_.async_wait(guarded([this, generation](const asio::error_code& error) {
+                if (error == asio::error::operation_aborted || generation != lazy_generation_) return;
+                lazy_at_.reset();
+                drive(true);
+            }));
+            return;
+        }
         if (wake_at_ && *wake_at_ == until) return;
         wake_at_ = until;
         const std::uint64_t generation = ++wake_generation_;
@@ -438,7 +464,8 @@ private:
     LineMaster master_;
     LineScheduler scheduler_;
     LinePort port_;
-    asio::steady_timer wake_timer_;
+    asio::steady_timer wake_timer_;  ///< short waits, set to the instant
+    asio::steady_timer lazy_timer_;  ///< long waits, may wake early (arm_wake)
     asio::steady_timer reopen_timer_;
     LineStateCallback on_state_;
     std::shared_ptr<char> alive_ = std::make_shared<char>('\0');
@@ -448,6 +475,8 @@ private:
     std::size_t write_offset_ = 0;       ///< bytes of the current request already written
     std::optional<TimePoint> wake_at_;
     std::uint64_t wake_generation_ = 0;
+    std::optional<TimePoint> lazy_at_;
+    std::uint64_t lazy_generation_ = 0;
     Duration reopen_delay_;
     unsigned open_attempts_ = 0;  ///< since the line went down (or since start)
     std::uint64_t reopens_ = 0;

@@ -143,4 +143,55 @@ TEST_CASE("worker: back-to-back transactions read the port about once each, not 
     worker.stop();
 }
 
+TEST_CASE("worker: after many answered requests, a reply timeout is judged at its deadline, not late or early") {
+    // Long waits (response timeouts) share a timer that is not re-set for every
+    // request: it may wake the worker early, which then waits on. The timeout must
+    // still be decided at written + wire time + response_timeout.
+    asio::io_context io;
+    auto owned = std::make_unique<ChunkedPort>(256);
+    ChunkedPort& port = *owned;
+    fe::LineWorkerConfig config;
+    config.name = "W";
+    config.timing.response_timeout = 60ms;
+    fe::LineWorker worker(io, config, std::move(owned));
+    worker.scheduler().add_device(0, fe::DeviceLimits{});
+    worker.start();
+    REQUIRE(worker.line_up());
+
+    Recorder recorder;
+    constexpr int answered_first = 8;  // within the default queue limit
+    for (int i = 0; i < answered_first; ++i) {
+        worker.submit(tagged(read_tx(1, Priority::on_demand), recorder, "read" + std::to_string(i)));
+    }
+    int requests_seen = 0;
+    fe::TimePoint last_request_seen{};
+    REQUIRE(run_until(io, [&] {
+        std::array<std::uint8_t, 64> buffer{};
+        const ssize_t n = ::recv(port.peer(), buffer.data(), buffer.size(), MSG_DONTWAIT);
+        if (n == 8) {
+            ++requests_seen;
+            last_request_seen = fe::Clock::now();
+            if (requests_seen <= answered_first) {
+                const Bytes reply = fp::encode_rtu(
+                    1, fp::encode_response(fp::ReadRegistersResponse{fp::fc::read_holding_registers, {7, 8}}));
+                REQUIRE(::send(port.peer(), reply.data(), reply.size(), 0) == static_cast<ssize_t>(reply.size()));
+                if (requests_seen == answered_first) {
+                    Transaction last = read_tx(1, Priority::on_demand);
+                    last.retry_allowed = false;  // one request on the wire, one timeout
+                    worker.submit(tagged(std::move(last), recorder, "unanswered"));
+                }
+            }
+        }
+        return recorder.calls("unanswered") == 1;
+    }));
+    REQUIRE(requests_seen == answered_first + 1);
+    CHECK(recorder.status("unanswered") == OutcomeStatus::timeout);
+    const auto waited = recorder.outcome("unanswered").finished - last_request_seen;
+    INFO("timeout judged " << std::chrono::duration_cast<std::chrono::microseconds>(waited).count()
+                           << " us after the request was seen");
+    CHECK(waited >= 60ms);
+    CHECK(waited < 60ms + 40ms);  // wire time of 8 bytes (0.7 ms) and scheduling
+    worker.stop();
+}
+
 }  // namespace
