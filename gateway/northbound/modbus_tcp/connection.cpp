@@ -79,6 +79,16 @@ Connection::~Connection() = default;
 
 void Connection::start() {
     last_activity_ = Clock::now();
+    // write() tries a send at once: it must never block on a client that stopped
+    // reading. (asio's asynchronous operations work the same either way.)
+    asio::error_code error;
+    socket_.non_blocking(true, error);
+    if (error) {
+        log(context_->log, LogLevel::info, "Modbus TCP: client {}: cannot make the socket non-blocking: {}", peer_,
+            error.message());
+        close(CloseReason::io_error);
+        return;
+    }
     arm_idle_timer();
     read();
 }
@@ -239,6 +249,18 @@ void Connection::respond(std::uint16_t transaction_id, std::uint8_t unit, protoc
 
 void Connection::write() {
     if (writing_ || closed_ || out_pending_.empty()) return;
+    // Answers are small and the socket's buffer is almost always free: sent at once,
+    // they cost no pass through the loop for an asynchronous write's completion
+    // (docs/performance.md). What does not fit (a client that does not read), and a
+    // failed send, go the asynchronous way; on_write reports the failure.
+    asio::error_code send_error;
+    const std::size_t sent = socket_.write_some(asio::buffer(out_pending_), send_error);
+    if (!send_error && sent == out_pending_.size()) {
+        out_pending_.clear();
+        last_activity_ = Clock::now();
+        return;
+    }
+    if (!send_error) out_pending_.erase(out_pending_.begin(), out_pending_.begin() + static_cast<std::ptrdiff_t>(sent));
     writing_ = true;
     out_sending_.swap(out_pending_);
     asio::async_write(socket_, asio::buffer(out_sending_),
