@@ -50,6 +50,7 @@
 
 #include "daemon_process.hpp"
 #include "engine/line_timing.hpp"
+#include "loopback_port.hpp"
 #include "sim_process.hpp"
 
 namespace {
@@ -60,22 +61,6 @@ using std::chrono::duration;
 using std::chrono::milliseconds;
 
 constexpr std::uint16_t status_address = 0x0300;
-
-/// A loopback port free at the moment of asking (the daemon binds it right after).
-std::uint16_t free_port() {
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
-        close(fd);
-        throw std::runtime_error("cannot bind a loopback port to find a free one");
-    }
-    socklen_t length = sizeof address;
-    getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-    close(fd);
-    return ntohs(address.sin_port);
-}
 
 struct ClientResult {
     std::vector<double> latency_us;  ///< requests sent inside the window (paced: from when due)
@@ -359,7 +344,7 @@ std::uint64_t bus_counter(const integration::SimProcess& sim, const char* bus, c
 int run(const std::string& daemon_binary, double seconds, int write_count) {
     integration::SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-b:hiwin-xeg@2",
                                  "--wire-time", "--baud", "115200", "--turnaround", "1ms"});
-    const std::uint16_t port = free_port();
+    const std::uint16_t port = bench::free_loopback_port();
     const auto config_path = sim.dir() / "bench.yaml";
     std::ofstream(config_path) << daemon_yaml(port, sim.path("line-a"), sim.path("line-b"));
     bench::DaemonProcess daemon(daemon_binary, config_path, sim.dir() / "fieldbridge.log");

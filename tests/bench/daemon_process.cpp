@@ -65,11 +65,11 @@ double DaemonProcess::cpu_seconds() const {
     return static_cast<double>(used.tv_sec) + static_cast<double>(used.tv_nsec) / 1e9;
 }
 
-long DaemonProcess::rss_kib() const {
-    std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
+long DaemonProcess::proc_kib(const std::string& file, const std::string& field) const {
+    std::ifstream in("/proc/" + std::to_string(pid_) + "/" + file);
     std::string line;
     while (std::getline(in, line)) {
-        if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+        if (line.rfind(field, 0) == 0) return std::stol(line.substr(field.size()));
     }
     return 0;
 }

@@ -27,12 +27,20 @@ public:
     /// User + system CPU time the daemon used so far (its process CPU-time clock, ns).
     [[nodiscard]] double cpu_seconds() const;
     /// Resident set size in KiB (VmRSS of /proc/<pid>/status); 0 when unreadable.
-    [[nodiscard]] long rss_kib() const;
+    [[nodiscard]] long rss_kib() const { return proc_kib("status", "VmRSS:"); }
+    /// The largest resident set size so far (VmHWM), in KiB; 0 when unreadable.
+    [[nodiscard]] long peak_rss_kib() const { return proc_kib("status", "VmHWM:"); }
+    /// A field of /proc/<pid>/smaps_rollup ("Pss:", "Pss_Anon:", "Private_Dirty:"...)
+    /// in KiB; 0 when unreadable.
+    [[nodiscard]] long memory_kib(const std::string& field) const { return proc_kib("smaps_rollup", field); }
     /// SIGTERM, bounded wait, SIGKILL; the exit status or -1 when killed. Idempotent.
     int terminate(std::chrono::milliseconds timeout = std::chrono::seconds{10});
     [[nodiscard]] std::string log_text() const;
 
 private:
+    /// A "Name:   123 kB" field of /proc/<pid>/@p file, in KiB; 0 when unreadable.
+    [[nodiscard]] long proc_kib(const std::string& file, const std::string& field) const;
+
     std::filesystem::path log_;
     pid_t pid_ = -1;
     int exit_status_ = -1;
