@@ -62,16 +62,44 @@ private:
     bool accept_ = false;
 };
 
-TEST_CASE("worker: a request the driver takes in pieces goes out whole, then the reply is awaited") {
+/// A started worker "W" with one device (address 1) on a ChunkedPort taking
+/// @p chunk bytes per write, and the device's side of the line.
+struct ChunkedLine {
+    explicit ChunkedLine(std::size_t chunk, fe::LineWorkerConfig config = {})
+        : owned(std::make_unique<ChunkedPort>(chunk)),
+          port(*owned),
+          worker(io, named(std::move(config)), std::move(owned)) {
+        worker.scheduler().add_device(0, fe::DeviceLimits{});
+        worker.start();
+        REQUIRE(worker.line_up());
+    }
+    static fe::LineWorkerConfig named(fe::LineWorkerConfig config) {
+        config.name = "W";
+        return config;
+    }
+    /// True when the device side received one whole read request (8 bytes).
+    bool read_request_arrived() {
+        std::array<std::uint8_t, 64> buffer{};
+        return ::recv(port.peer(), buffer.data(), buffer.size(), MSG_DONTWAIT) == 8;
+    }
+    /// Answers a read whole, as the device would.
+    void answer_read() {
+        const Bytes reply =
+            fp::encode_rtu(1, fp::encode_response(fp::ReadRegistersResponse{fp::fc::read_holding_registers, {7, 8}}));
+        REQUIRE(::send(port.peer(), reply.data(), reply.size(), 0) == static_cast<ssize_t>(reply.size()));
+    }
+
     asio::io_context io;
-    auto owned = std::make_unique<ChunkedPort>(3);
-    ChunkedPort& port = *owned;
-    fe::LineWorkerConfig config;
-    config.name = "W";
-    fe::LineWorker worker(io, config, std::move(owned));
-    worker.scheduler().add_device(0, fe::DeviceLimits{});
-    worker.start();
-    REQUIRE(worker.line_up());
+    std::unique_ptr<ChunkedPort> owned;  ///< moved into the worker
+    ChunkedPort& port;
+    fe::LineWorker worker;
+};
+
+TEST_CASE("worker: a request the driver takes in pieces goes out whole, then the reply is awaited") {
+    ChunkedLine line(3);
+    auto& io = line.io;
+    auto& port = line.port;
+    auto& worker = line.worker;
 
     Recorder recorder;
     const std::vector<std::uint16_t> values{1, 2, 3, 4, 5, 6, 7};
@@ -106,15 +134,10 @@ TEST_CASE("worker: back-to-back transactions read the port about once each, not 
     // judging a timeout cannot find anything new: it would cost a system call per
     // transaction for nothing (docs/performance.md). 8 transactions with whole
     // replies: one read each, plus a few for the start and the posted submissions.
-    asio::io_context io;
-    auto owned = std::make_unique<ChunkedPort>(256);
-    ChunkedPort& port = *owned;
-    fe::LineWorkerConfig config;
-    config.name = "W";
-    fe::LineWorker worker(io, config, std::move(owned));
-    worker.scheduler().add_device(0, fe::DeviceLimits{});
-    worker.start();
-    REQUIRE(worker.line_up());
+    ChunkedLine line(256);
+    auto& io = line.io;
+    auto& port = line.port;
+    auto& worker = line.worker;
 
     Recorder recorder;
     constexpr int transactions = 8;
@@ -124,12 +147,8 @@ TEST_CASE("worker: back-to-back transactions read the port about once each, not 
     const std::size_t reads_before = port.read_calls;
     std::size_t answered = 0;
     REQUIRE(run_until(io, [&] {
-        std::array<std::uint8_t, 64> buffer{};
-        const ssize_t n = ::recv(port.peer(), buffer.data(), buffer.size(), MSG_DONTWAIT);
-        if (n == 8) {  // one whole request: answer it whole
-            const Bytes reply =
-                fp::encode_rtu(1, fp::encode_response(fp::ReadRegistersResponse{fp::fc::read_holding_registers, {7, 8}}));
-            REQUIRE(::send(port.peer(), reply.data(), reply.size(), 0) == static_cast<ssize_t>(reply.size()));
+        if (line.read_request_arrived()) {  // one whole request: answer it whole
+            line.answer_read();
             ++answered;
         }
         return recorder.total() == transactions;
@@ -147,16 +166,11 @@ TEST_CASE("worker: after many answered requests, a reply timeout is judged at it
     // Long waits (response timeouts) share a timer that is not re-set for every
     // request: it may wake the worker early, which then waits on. The timeout must
     // still be decided at written + wire time + response_timeout.
-    asio::io_context io;
-    auto owned = std::make_unique<ChunkedPort>(256);
-    ChunkedPort& port = *owned;
     fe::LineWorkerConfig config;
-    config.name = "W";
     config.timing.response_timeout = 60ms;
-    fe::LineWorker worker(io, config, std::move(owned));
-    worker.scheduler().add_device(0, fe::DeviceLimits{});
-    worker.start();
-    REQUIRE(worker.line_up());
+    ChunkedLine line(256, config);
+    auto& io = line.io;
+    auto& worker = line.worker;
 
     Recorder recorder;
     constexpr int answered_first = 8;  // within the default queue limit
@@ -166,15 +180,11 @@ TEST_CASE("worker: after many answered requests, a reply timeout is judged at it
     int requests_seen = 0;
     fe::TimePoint last_request_seen{};
     REQUIRE(run_until(io, [&] {
-        std::array<std::uint8_t, 64> buffer{};
-        const ssize_t n = ::recv(port.peer(), buffer.data(), buffer.size(), MSG_DONTWAIT);
-        if (n == 8) {
+        if (line.read_request_arrived()) {
             ++requests_seen;
             last_request_seen = fe::Clock::now();
             if (requests_seen <= answered_first) {
-                const Bytes reply = fp::encode_rtu(
-                    1, fp::encode_response(fp::ReadRegistersResponse{fp::fc::read_holding_registers, {7, 8}}));
-                REQUIRE(::send(port.peer(), reply.data(), reply.size(), 0) == static_cast<ssize_t>(reply.size()));
+                line.answer_read();
                 if (requests_seen == answered_first) {
                     Transaction last = read_tx(1, Priority::on_demand);
                     last.retry_allowed = false;  // one request on the wire, one timeout
