@@ -46,6 +46,15 @@ void call_on_done(Transaction& transaction, const Outcome& outcome, const LogSin
 }  // namespace
 
 class LineWorker::Impl {
+    /// A timer that wakes drive(): when it is set for, and a generation that tells its
+    /// current wait from one it replaced.
+    struct WakeTimer {
+        explicit WakeTimer(asio::io_context& io) : timer(io) {}
+        asio::steady_timer timer;
+        std::optional<TimePoint> at;  ///< set and not fired yet
+        std::uint64_t generation = 0;
+    };
+
 public:
     Impl(asio::io_context& io, LineWorkerConfig config, std::unique_ptr<SerialPort> port, LogSink log)
         : io_(io),
@@ -54,8 +63,8 @@ public:
           master_(config_.name, config_.timing, log_),
           scheduler_(scheduler_config(config_), log_),
           port_(io, std::move(port)),
-          wake_timer_(io),
-          lazy_timer_(io),
+          wake_(io),
+          lazy_(io),
           reopen_timer_(io),
           reopen_delay_(config_.reopen_initial) {
         if (config_.reopen_initial <= Duration::zero() || config_.reopen_max < config_.reopen_initial) {
@@ -113,8 +122,8 @@ public:
         stopped_ = true;
         const TimePoint now = Clock::now();
         const bool was_up = line_up_;
-        wake_timer_.cancel();
-        lazy_timer_.cancel();
+        wake_.timer.cancel();
+        lazy_.timer.cancel();
         reopen_timer_.cancel();
         close_port();
         if (auto finished = master_.abort(now)) {
@@ -266,33 +275,28 @@ private:
     }
 
     /// Wakes drive() at @p until (or earlier: drive() always looks again). Short waits
-    /// (silences, gaps, turnarounds) set wake_timer_ to the instant. Long ones (a
-    /// reply's timeout, the next poll) go to lazy_timer_, which is left alone when it
-    /// is already due no later than needed: it then wakes drive() early, once per
-    /// timeout period rather than per transaction, and is set again from there.
-    /// Re-setting a pending timer for every request would cancel its wait (one more
-    /// pass through the reactor) and update the timerfd each time
-    /// (docs/performance.md, "CPU per transaction").
+    /// (silences, gaps, turnarounds) set wake_ to the instant. Long ones (a reply's
+    /// timeout, the next poll) go to lazy_, which is left alone when it is already due
+    /// no later than needed: it then wakes drive() early, once per timeout period
+    /// rather than per transaction, and is set again from there. Re-setting a pending
+    /// timer for every request would cancel its wait (one more pass through the
+    /// reactor) and update the timerfd each time (docs/performance.md, "CPU per
+    /// transaction").
     void arm_wake(TimePoint until, TimePoint now) {
         if (until - now >= lazy_wait) {
-            if (lazy_at_ && *lazy_at_ <= until) return;
-            lazy_at_ = until;
-            const std::uint64_t generation = ++lazy_generation_;
-            lazy_timer_.expires_at(until);
-            lazy_timer_.async_wait(guarded([this, generation](const asio::error_code& error) {
-                if (error == asio::error::operation_aborted || generation != lazy_generation_) return;
-                lazy_at_.reset();
-                drive(true);
-            }));
+            if (!lazy_.at || *lazy_.at > until) set(lazy_, until);
             return;
         }
-        if (wake_at_ && *wake_at_ == until) return;
-        wake_at_ = until;
-        const std::uint64_t generation = ++wake_generation_;
-        wake_timer_.expires_at(until);
-        wake_timer_.async_wait(guarded([this, generation](const asio::error_code& error) {
-            if (error == asio::error::operation_aborted || generation != wake_generation_) return;
-            wake_at_.reset();
+        if (!wake_.at || *wake_.at != until) set(wake_, until);
+    }
+
+    void set(WakeTimer& wake, TimePoint until) {
+        wake.at = until;
+        const std::uint64_t generation = ++wake.generation;
+        wake.timer.expires_at(until);
+        wake.timer.async_wait(guarded([this, &wake, generation](const asio::error_code& error) {
+            if (error == asio::error::operation_aborted || generation != wake.generation) return;
+            wake.at.reset();
             drive(true);
         }));
     }
@@ -464,8 +468,8 @@ private:
     LineMaster master_;
     LineScheduler scheduler_;
     LinePort port_;
-    asio::steady_timer wake_timer_;  ///< short waits, set to the instant
-    asio::steady_timer lazy_timer_;  ///< long waits, may wake early (arm_wake)
+    WakeTimer wake_;  ///< short waits, set to the instant
+    WakeTimer lazy_;  ///< long waits, may wake early (arm_wake)
     asio::steady_timer reopen_timer_;
     LineStateCallback on_state_;
     std::shared_ptr<char> alive_ = std::make_shared<char>('\0');
@@ -473,10 +477,6 @@ private:
     std::vector<Transaction> inbox_;     ///< submitted, not yet handed to the scheduler
     std::vector<Transaction> draining_;  ///< the inbox being handed over (capacity reused)
     std::size_t write_offset_ = 0;       ///< bytes of the current request already written
-    std::optional<TimePoint> wake_at_;
-    std::uint64_t wake_generation_ = 0;
-    std::optional<TimePoint> lazy_at_;
-    std::uint64_t lazy_generation_ = 0;
     Duration reopen_delay_;
     unsigned open_attempts_ = 0;  ///< since the line went down (or since start)
     std::uint64_t reopens_ = 0;
