@@ -18,7 +18,6 @@
 // separate process, so the CPU figure is the gateway side alone (engine, scheduler,
 // line I/O and this load generator's callbacks). Not a test: it prints figures and
 // asserts nothing.
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <asio/steady_timer.hpp>
@@ -34,6 +33,7 @@
 #include <fmt/format.h>
 
 #include "engine/line_timing.hpp"
+#include "process_cpu.hpp"
 #include "raw_master.hpp"
 #include "engine_harness.hpp"
 #include "sim_process.hpp"
@@ -56,20 +56,6 @@ constexpr std::size_t read_request_bytes = 8;
 constexpr std::size_t read_reply_bytes = 9;
 constexpr std::size_t write_request_bytes = 11;
 constexpr std::size_t write_reply_bytes = 8;
-
-struct CpuTimes {
-    double user = 0.0;
-    double sys = 0.0;
-};
-
-CpuTimes cpu_times() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    const auto to_seconds = [](const timeval& tv) {
-        return static_cast<double>(tv.tv_sec) + static_cast<double>(tv.tv_usec) / 1e6;
-    };
-    return {to_seconds(usage.ru_utime), to_seconds(usage.ru_stime)};
-}
 
 double ms(Clock::duration d) { return duration<double, std::milli>(d).count(); }
 
@@ -182,11 +168,11 @@ int run(double run_seconds, int write_count) {
     const auto t0 = Clock::now();
     for (int w = 0; w < windows; ++w) {
         const std::uint64_t before = reads.completed();
-        const CpuTimes cpu0 = cpu_times();
+        const bench::CpuTimes cpu0 = bench::process_cpu();
         const auto w0 = Clock::now();
         h.run_for(std::chrono::duration_cast<engine::Duration>(duration<double>(run_seconds)));
         const auto w1 = Clock::now();
-        const CpuTimes cpu1 = cpu_times();
+        const bench::CpuTimes cpu1 = bench::process_cpu();
         const auto done = static_cast<double>(reads.completed() - before);
         window_tps.push_back(done / duration<double>(w1 - w0).count());
         window_cpu.push_back(((cpu1.user - cpu0.user) + (cpu1.sys - cpu0.sys)) * 1e6 / done);

@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/prctl.h>
-#include <sys/resource.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -14,26 +13,13 @@
 #include <stdexcept>
 
 #include "engine/line_timing.hpp"
+#include "process_cpu.hpp"
 #include "protocol/rtu_frame.hpp"
 
 namespace fieldbridge::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-struct Cpu {
-    double user = 0.0;
-    double sys = 0.0;
-};
-
-Cpu cpu_now() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    const auto seconds = [](const timeval& tv) {
-        return static_cast<double>(tv.tv_sec) + static_cast<double>(tv.tv_usec) / 1e6;
-    };
-    return {seconds(usage.ru_utime), seconds(usage.ru_stime)};
-}
 
 /// Owns the pty file descriptor.
 class RawPort {
@@ -76,7 +62,7 @@ RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, st
 
     RawPort port(path);
     RawMasterResult result;
-    const Cpu cpu0 = cpu_now();
+    const CpuTimes cpu0 = process_cpu();
     const auto start = Clock::now();
     const auto end = start + std::chrono::duration_cast<Clock::duration>(duration);
     std::array<std::uint8_t, 256> buffer{};
@@ -98,7 +84,7 @@ RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, st
         }
         sleep_until(Clock::now() + timing.t3_5());
     }
-    const Cpu cpu1 = cpu_now();
+    const CpuTimes cpu1 = process_cpu();
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (result.transactions > 0) {
         const auto n = static_cast<double>(result.transactions);
