@@ -18,7 +18,7 @@ constexpr std::uint16_t command_last = 0x4E26;
 constexpr std::uint16_t coil_count = 0x0120;  // Y, M, EUY: 0x0000-0x011F (seed 004 section 5)
 constexpr std::int64_t sweep_speed = 10'000;  // axis 0: 10 deg/s at 100 % global speed
 constexpr std::int64_t amplitude_0 = 30'000;  // axis i sweeps 0 .. 30 + 10 i degrees
-constexpr std::int64_t ns_per_s = 1'000'000'000;
+constexpr std::int64_t ns_per_second = 1'000'000'000;
 constexpr std::int64_t ns_per_ms = 1'000'000;
 
 std::int64_t amplitude(std::size_t axis) noexcept {
@@ -218,11 +218,11 @@ void R6Model::step_motion(Clock::duration elapsed) {
         // Time to the end of the cycle, in ns, from the current phase.
         const std::int64_t to_end_units = period - phase_;
         const std::int64_t to_end_ns =
-            (to_end_units * ns_per_s - phase_remainder_ + speed - 1) / speed;
+            (to_end_units * ns_per_second - phase_remainder_ + speed - 1) / speed;
         if (ns < to_end_ns) {
             const std::int64_t total = phase_remainder_ + speed * ns;
-            phase_ += total / ns_per_s;
-            phase_remainder_ = total % ns_per_s;
+            phase_ += total / ns_per_second;
+            phase_remainder_ = total % ns_per_second;
             cycle_elapsed_ns_ += ns;
             ns = 0;
         } else {

@@ -10,8 +10,6 @@ namespace wtec = protocol::wtec;
 
 // seed 003 command 1 example: ">01ACstep [A]1.623921".
 constexpr std::string_view firmware_version = "Cstep [A]1.62";
-constexpr std::uint32_t min_stroke = 100;
-constexpr std::uint32_t max_stroke = 10'000'000;
 
 /// Runs one decoded command on the gripper; the reply it gets, if any.
 struct Executor {
@@ -97,7 +95,7 @@ WtecAsciiModel::WtecAsciiModel(std::uint8_t address, std::uint32_t stroke)
         throw std::invalid_argument("wtec-ascii: address " + std::to_string(address) +
                                     " is outside 1-253 (0 is the broadcast address)");
     }
-    if (stroke < min_stroke || stroke > max_stroke) {
+    if (stroke < WtecGripper::min_stroke || stroke > WtecGripper::max_stroke) {
         throw std::invalid_argument("wtec-ascii: stroke " + std::to_string(stroke) +
                                     " counts is outside 100-10000000");
     }

@@ -37,6 +37,10 @@ namespace fieldbridge::sim {
 
 class WtecGripper {
 public:
+    /// The strokes a model accepts (encoder counts; DeviceOptions::wtec_stroke).
+    static constexpr std::uint32_t min_stroke = 100;
+    static constexpr std::uint32_t max_stroke = 10'000'000;
+
     /// @p stroke encoder counts from end to end (DeviceOptions::wtec_stroke).
     explicit WtecGripper(std::uint32_t stroke);
 

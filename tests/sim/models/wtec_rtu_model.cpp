@@ -18,7 +18,7 @@ constexpr std::uint16_t reg_init = 0x0100;
 constexpr std::uint16_t reg_estop = 0x0102;
 constexpr std::uint16_t reg_force = 0x0103;
 constexpr std::uint16_t reg_speed = 0x0104;
-constexpr std::uint16_t reg_position = 0x0105;
+constexpr std::uint16_t reg_position_command = 0x0105;
 constexpr std::uint16_t reg_init_state = 0x0200;
 constexpr std::uint16_t reg_grip_state = 0x0202;
 constexpr std::uint16_t reg_instant_position = 0x0204;
@@ -26,8 +26,6 @@ constexpr std::uint16_t reg_init_direction = 0x0300;
 constexpr std::uint16_t reg_save = 0x0302;
 constexpr std::uint16_t reg_device_id = 0x0303;
 constexpr std::uint8_t max_modbus_address = 247;  // Modbus over Serial Line 2.2
-constexpr std::uint32_t min_stroke = 100;
-constexpr std::uint32_t max_stroke = 10'000'000;
 
 bool in_block(std::uint16_t address) noexcept {
     return (address >= 0x0100 && address <= 0x0105) || (address >= 0x0200 && address <= 0x0205) ||
@@ -67,7 +65,7 @@ WtecRtuModel::WtecRtuModel(std::uint8_t address, std::uint32_t stroke)
         throw std::invalid_argument("wtec-rtu: address " + std::to_string(address) +
                                     " is outside 1-247 (0 is the broadcast address)");
     }
-    if (stroke < min_stroke || stroke > max_stroke) {
+    if (stroke < WtecGripper::min_stroke || stroke > WtecGripper::max_stroke) {
         throw std::invalid_argument("wtec-rtu: stroke " + std::to_string(stroke) +
                                     " counts is outside 100-10000000");
     }
@@ -101,7 +99,7 @@ std::optional<std::uint16_t> WtecRtuModel::register_value(std::uint16_t address)
         case reg_estop: return gripper_.estop_latched() ? 1 : 0;
         case reg_force: return gripper_.force_percent();
         case reg_speed: return gripper_.speed_percent();
-        case reg_position:
+        case reg_position_command:
             return wtec_percent_of(static_cast<std::int32_t>(gripper_.gripper_params().target),
                                    gripper_.stroke());
         case reg_init_state: return wtec_init_state_register(gripper_.homing_state());
@@ -149,7 +147,7 @@ protocol::Response WtecRtuModel::write(const protocol::WriteSingleRegisterReques
             if (v < 1 || v > 100) return bad_value;
             gripper_.set_speed_percent(v);
             return echo;
-        case reg_position: {
+        case reg_position_command: {
             if (v > 100) return bad_value;
             const std::int64_t target = (std::int64_t{v} * gripper_.stroke() + 50) / 100;
             if (!gripper_.move_to(static_cast<std::int32_t>(target), now)) {

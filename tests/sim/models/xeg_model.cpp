@@ -18,7 +18,7 @@ constexpr std::uint16_t di_first = 0x0000;
 constexpr std::uint16_t di_last = 0x0007;
 constexpr std::uint16_t do_first = 0x0010;
 constexpr std::uint16_t do_last = 0x0017;
-constexpr std::uint16_t reg_position = 0x0300;
+constexpr std::uint16_t reg_current_position = 0x0300;
 constexpr std::uint16_t reg_status = 0x0301;
 constexpr std::uint16_t reg_firmware = 0x0303;
 constexpr std::uint16_t reg_model = 0x0600;
@@ -50,7 +50,7 @@ bool is_holding(std::uint16_t address) noexcept {
 }
 
 bool is_input_register(std::uint16_t address) noexcept {
-    return address == reg_position || address == reg_status ||
+    return address == reg_current_position || address == reg_status ||
            (address >= reg_firmware && address < reg_firmware + firmware.size());
 }
 
@@ -173,7 +173,7 @@ protocol::Response XegModel::read_input_registers(const protocol::ReadRegistersR
     protocol::ReadRegistersResponse response{request.function, {}};
     for (std::uint16_t i = 0; i < request.count; ++i) {
         const auto address = static_cast<std::uint16_t>(request.address + i);
-        if (address == reg_position) {
+        if (address == reg_current_position) {
             const std::int64_t clamped = position_ < 0 ? 0 : (position_ > max_position ? max_position : position_);
             response.values.push_back(static_cast<std::uint16_t>(clamped));
         } else if (address == reg_status) {

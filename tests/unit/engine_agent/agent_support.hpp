@@ -237,6 +237,14 @@ inline fe::DeviceAgentConfig test_config() {
     return c;
 }
 
+/// An agent that does not poll: only the requests of the test reach the line.
+inline fe::DeviceAgentConfig quiet(fe::Duration max_age = 0ms) {
+    fe::DeviceAgentConfig c = test_config();
+    c.polling = false;
+    c.max_age = max_age;
+    return c;
+}
+
 /// An io_context kept alive, a fake line, and one agent of @p type on it.
 struct Rig {
     asio::io_context io;

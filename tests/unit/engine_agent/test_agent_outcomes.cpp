@@ -10,12 +10,6 @@ using namespace fbt;
 using fe::OutcomeStatus;
 using fp::ExceptionCode;
 
-fe::DeviceAgentConfig quiet() {
-    fe::DeviceAgentConfig c = test_config();
-    c.polling = false;
-    return c;
-}
-
 struct Case {
     OutcomeStatus status;
     ExceptionCode code;

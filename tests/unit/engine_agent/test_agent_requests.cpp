@@ -9,14 +9,6 @@ using namespace fbt;
 using fe::Table;
 using fp::ExceptionCode;
 
-/// An XEG agent that does not poll: only the requests of the test reach the line.
-fe::DeviceAgentConfig quiet(fe::Duration max_age = 0ms) {
-    fe::DeviceAgentConfig c = test_config();
-    c.polling = false;
-    c.max_age = max_age;
-    return c;
-}
-
 }  // namespace
 
 TEST_CASE("agent requests: what the profile refuses is answered locally, later, without line time") {

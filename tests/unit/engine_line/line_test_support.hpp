@@ -74,6 +74,17 @@ inline Transaction read_tx(fe::DeviceIndex device, std::uint8_t address, Priorit
     return t;
 }
 
+/// One character at 115200 8N1 (11 bits).
+inline constexpr std::chrono::nanoseconds tc{86'806};
+
+// XEG id 2: read model 0x0600 -> 0x0A20 (seed 001, appendix 1; tests/vectors/vectors.yaml).
+inline const Bytes read_model_request = {0x02, 0x03, 0x06, 0x00, 0x00, 0x01, 0x84, 0xB1};
+inline const Bytes read_model_reply = {0x02, 0x03, 0x02, 0x0A, 0x20, 0xFB, 0x3C};
+
+inline Transaction read_model() {
+    return read_tx(0, 2, Priority::poll, 0x0600, 1, fp::fc::read_holding_registers);
+}
+
 /// FC06 command.
 inline Transaction write_tx(fe::DeviceIndex device, std::uint8_t address, std::uint16_t reg,
                             std::uint16_t value) {

@@ -15,14 +15,7 @@ using namespace line_test;
 using fe::OutcomeStatus;
 using std::chrono::nanoseconds;
 
-constexpr nanoseconds tc{86'806};   // 115200 8N1
 constexpr nanoseconds t35{303'820};
-
-// XEG id 2: read model 0x0600 (seed 001, appendix 1; tests/vectors/vectors.yaml).
-const Bytes read_model_request = {0x02, 0x03, 0x06, 0x00, 0x00, 0x01, 0x84, 0xB1};
-const Bytes read_model_reply = {0x02, 0x03, 0x02, 0x0A, 0x20, 0xFB, 0x3C};
-
-Transaction read_model() { return read_tx(0, 2, Priority::poll, 0x0600, 1, fp::fc::read_holding_registers); }
 
 /// FC06 to XEG id 2; the reply of FC06 echoes the request byte for byte.
 Transaction write_register(std::uint16_t reg = 0x0601, std::uint16_t value = 1) {

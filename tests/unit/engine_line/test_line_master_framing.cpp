@@ -13,12 +13,6 @@ using namespace line_test;
 using fe::OutcomeStatus;
 using std::chrono::nanoseconds;
 
-constexpr nanoseconds tc{86'806};
-
-// XEG id 2 (seed 001, appendix 1): read model 0x0600 -> 0x0A20.
-const Bytes read_model_reply = {0x02, 0x03, 0x02, 0x0A, 0x20, 0xFB, 0x3C};
-
-Transaction read_model() { return read_tx(0, 2, Priority::poll, 0x0600, 1, fp::fc::read_holding_registers); }
 
 struct Sent {
     fe::LineMaster master{"A", default_line()};

@@ -61,7 +61,7 @@ private:
     std::uint64_t next_ = 1;
 };
 
-fm::BridgeSettings settings() {
+fm::BridgeSettings bridge_settings() {
     fm::BridgeSettings s;
     s.prefix = "p";
     s.throttle.min_interval = 0ms;
@@ -83,7 +83,7 @@ void run(asio::io_context& io, std::chrono::milliseconds d) {
 TEST_CASE("bridge: at most max_in_flight unacknowledged publications; the rest wait, bounded, newest state kept") {
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
-    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
     auto source = std::make_shared<FakeSource>(io, "g1");
     bridge.set_sources({source});
     bridge.start();
@@ -125,7 +125,7 @@ TEST_CASE("bridge: reconnection attempts back off, doubling up to the maximum") 
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
     log->accept_connect = false;
-    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
     bridge.start();
     const auto until = std::chrono::steady_clock::now() + 2s;
     while (log->connects.size() < 6 && std::chrono::steady_clock::now() < until) run(io, 5ms);
@@ -142,7 +142,7 @@ TEST_CASE("bridge: reconnection attempts back off, doubling up to the maximum") 
 TEST_CASE("bridge: a clean stop publishes offline, waits for it, then disconnects") {
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
-    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
     bridge.start();
     run(io, 20ms);
     for (auto id : log->ids) log->events.published(id, true);
@@ -163,7 +163,7 @@ TEST_CASE("bridge: a clean stop publishes offline, waits for it, then disconnect
 TEST_CASE("bridge: a retained command is never executed") {
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
-    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
     auto source = std::make_shared<FakeSource>(io, "g1");
     bridge.set_sources({source});
     bridge.start();
@@ -189,7 +189,7 @@ TEST_CASE("bridge: a retained command is never executed") {
 TEST_CASE("bridge: WTEC grip uses the device's init direction; unknown, nothing is sent") {
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
-    fm::Bridge bridge(io, settings(), std::make_unique<ScriptedClient>(io, log));
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
     auto source = std::make_shared<FakeSource>(io, "w1", fm::CommandSet::wtec);
     bridge.set_sources({source});
     bridge.start();

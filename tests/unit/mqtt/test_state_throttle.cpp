@@ -17,7 +17,7 @@ fm::SourceState with(double position, std::string status = "idle", bool online =
     return s;
 }
 
-fm::ThrottleSettings settings() {
+fm::ThrottleSettings throttle_settings() {
     fm::ThrottleSettings s;
     s.min_interval = 200ms;
     s.heartbeat = 10s;
@@ -28,7 +28,7 @@ fm::ThrottleSettings settings() {
 }  // namespace
 
 TEST_CASE("throttle: the first state is due at once; nothing new is not due until the heartbeat") {
-    fm::StateThrottle t(settings());
+    fm::StateThrottle t(throttle_settings());
     const fe::TimePoint t0{};
     CHECK(t.due(with(1.0), t0));
     t.published(with(1.0), t0);
@@ -38,7 +38,7 @@ TEST_CASE("throttle: the first state is due at once; nothing new is not due unti
 }
 
 TEST_CASE("throttle: a change below the deadband is not published; drift adds up against the last published value") {
-    fm::StateThrottle t(settings());
+    fm::StateThrottle t(throttle_settings());
     const fe::TimePoint t0{};
     t.published(with(1.0), t0);
     CHECK_FALSE(t.due(with(1.03), t0 + 1s));
@@ -52,7 +52,7 @@ TEST_CASE("throttle: a change below the deadband is not published; drift adds up
 }
 
 TEST_CASE("throttle: a change waits for the minimum interval after the previous publication") {
-    fm::StateThrottle t(settings());
+    fm::StateThrottle t(throttle_settings());
     const fe::TimePoint t0{};
     t.published(with(1.0), t0);
     CHECK_FALSE(t.due(with(2.0), t0 + 100ms));
@@ -63,7 +63,7 @@ TEST_CASE("throttle: a change waits for the minimum interval after the previous 
 }
 
 TEST_CASE("throttle: reset makes the next state due at once (reconnect)") {
-    fm::StateThrottle t(settings());
+    fm::StateThrottle t(throttle_settings());
     t.published(with(1.0), fe::TimePoint{});
     CHECK_FALSE(t.due(with(1.0), fe::TimePoint{} + 1s));
     t.reset();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "protocol/modbus_pdu.hpp"
+#include "vectors.hpp"
 
 namespace {
 
@@ -18,16 +19,7 @@ using p::ByteView;
 using p::DecodeError;
 using p::DecodeStatus;
 
-std::string hex(ByteView bytes) {
-    static constexpr char digits[] = "0123456789ABCDEF";
-    std::string out;
-    for (const auto b : bytes) {
-        if (!out.empty()) out.push_back(' ');
-        out.push_back(digits[b >> 4]);
-        out.push_back(digits[b & 0x0F]);
-    }
-    return out;
-}
+using fieldbridge::test::hex;
 
 std::vector<bool> bits_of(std::initializer_list<int> ones_and_zeros) {
     std::vector<bool> bits;

@@ -10,6 +10,7 @@
 
 #include "protocol/crc16.hpp"
 #include "protocol/rtu_frame.hpp"
+#include "vectors.hpp"
 
 namespace {
 
@@ -18,7 +19,7 @@ using p::Bytes;
 using p::ByteView;
 
 template <typename T>
-std::string describe(const p::DecodeResult<T>& r) {
+std::string describe_consumed(const p::DecodeResult<T>& r) {
     switch (r.status) {
         case p::DecodeStatus::need_more: return "need_more";
         case p::DecodeStatus::complete: return "complete " + std::to_string(r.consumed);
@@ -28,16 +29,7 @@ std::string describe(const p::DecodeResult<T>& r) {
     return "?";
 }
 
-std::string hex(ByteView bytes) {
-    static constexpr char digits[] = "0123456789ABCDEF";
-    std::string out;
-    for (const auto b : bytes) {
-        if (!out.empty()) out.push_back(' ');
-        out.push_back(digits[b >> 4]);
-        out.push_back(digits[b & 0x0F]);
-    }
-    return out;
-}
+using fieldbridge::test::hex;
 
 Bytes concat(std::initializer_list<ByteView> parts) {
     Bytes out;
@@ -109,31 +101,31 @@ TEST_CASE("rtu: encode_rtu puts the CRC low byte first") {
 
 TEST_CASE("rtu: decode_rtu boundaries") {
     const auto ok = p::decode_rtu(read_model_reply);
-    CHECK(describe(ok) == "complete 7");
+    CHECK(describe_consumed(ok) == "complete 7");
     CHECK(ok.value == p::RtuFrame{0x02, {0x03, 0x02, 0x0A, 0x20}});
-    CHECK(describe(p::decode_rtu(Bytes{0x02, 0x07, 0x41, 0x12})) == "complete 4");
+    CHECK(describe_consumed(p::decode_rtu(Bytes{0x02, 0x07, 0x41, 0x12})) == "complete 4");
 
     for (std::size_t len = 0; len < 4; ++len) {
         CAPTURE(len);
-        CHECK(describe(p::decode_rtu(ByteView(read_model_reply).first(len))) ==
+        CHECK(describe_consumed(p::decode_rtu(ByteView(read_model_reply).first(len))) ==
               "malformed bad_length " + std::to_string(len));
     }
     for (std::size_t len = 4; len < read_model_reply.size(); ++len) {
         CAPTURE(len);
-        CHECK(describe(p::decode_rtu(ByteView(read_model_reply).first(len))) ==
+        CHECK(describe_consumed(p::decode_rtu(ByteView(read_model_reply).first(len))) ==
               "malformed bad_crc " + std::to_string(len));
     }
     Bytes longest = p::encode_rtu(0x01, Bytes(p::max_pdu_size, 0x41));
-    CHECK(describe(p::decode_rtu(longest)) == "complete 256");
+    CHECK(describe_consumed(p::decode_rtu(longest)) == "complete 256");
     longest.insert(longest.begin() + 1, 0x41);
-    CHECK(describe(p::decode_rtu(longest)) == "malformed oversize 257");
+    CHECK(describe_consumed(p::decode_rtu(longest)) == "malformed oversize 257");
 
     for (std::size_t i = 0; i < read_model_reply.size(); ++i) {
         for (unsigned bit = 0; bit < 8; ++bit) {
             Bytes corrupted = read_model_reply;
             corrupted[i] = static_cast<std::uint8_t>(corrupted[i] ^ (1U << bit));
             CAPTURE(hex(corrupted));
-            CHECK(describe(p::decode_rtu(corrupted)) == "malformed bad_crc 7");
+            CHECK(describe_consumed(p::decode_rtu(corrupted)) == "malformed bad_crc 7");
         }
     }
 }
@@ -156,13 +148,13 @@ TEST_CASE("rtu: a reply arriving byte by byte is need_more until complete") {
         CAPTURE(std::string(c.name));
         for (std::size_t len = 0; len < c.reply.size(); ++len) {
             CAPTURE(len);
-            CHECK(describe(p::frame_rtu_response(ByteView(c.reply).first(len), 0x02, c.request)) == "need_more");
+            CHECK(describe_consumed(p::frame_rtu_response(ByteView(c.reply).first(len), 0x02, c.request)) == "need_more");
         }
         const auto r = p::frame_rtu_response(c.reply, 0x02, c.request);
-        CHECK(describe(r) == "complete " + std::to_string(c.reply.size()));
+        CHECK(describe_consumed(r) == "complete " + std::to_string(c.reply.size()));
         CHECK(p::encode_rtu(r.value.address, r.value.pdu) == c.reply);
         // Whatever follows the reply is left for later.
-        CHECK(describe(p::frame_rtu_response(concat({c.reply, Bytes{0x02, 0x03}}), 0x02, c.request)) ==
+        CHECK(describe_consumed(p::frame_rtu_response(concat({c.reply, Bytes{0x02, 0x03}}), 0x02, c.request)) ==
               "complete " + std::to_string(c.reply.size()));
     }
 }
@@ -171,9 +163,9 @@ TEST_CASE("rtu: the 5-byte exception reply to an FC16 write whose reply would be
     const Bytes exception = p::encode_rtu(0x02, Bytes{0x90, 0x04});
     REQUIRE(exception.size() == 5);
     const auto r = p::frame_rtu_response(exception, 0x02, write_model);
-    CHECK(describe(r) == "complete 5");
+    CHECK(describe_consumed(r) == "complete 5");
     CHECK(r.value.pdu == Bytes{0x90, 0x04});
-    CHECK(describe(p::frame_rtu_response(write_model_reply, 0x02, write_model)) == "complete 8");
+    CHECK(describe_consumed(p::frame_rtu_response(write_model_reply, 0x02, write_model)) == "complete 8");
 }
 
 TEST_CASE("rtu: garbage before a reply is skipped and counted in consumed") {
@@ -186,14 +178,14 @@ TEST_CASE("rtu: garbage before a reply is skipped and counted in consumed") {
         const Bytes rx = concat({garbage, reply});
         const auto r = p::frame_rtu_response(rx, 0x02, request);
         if (!r.complete() || r.consumed != rx.size()) {
-            FAIL_CHECK(describe(r) << " for " << hex(rx));
+            FAIL_CHECK(describe_consumed(r) << " for " << hex(rx));
         } else if (p::encode_rtu(r.value.address, r.value.pdu) != reply) {
             FAIL_CHECK("wrong frame for " << hex(rx));
         }
     }
     // Typical line noise at bus turnaround: a few 0x00 / 0xFF bytes.
     const Bytes noisy = concat({Bytes{0x00, 0xFF, 0x00}, read_model_reply});
-    CHECK(describe(p::frame_rtu_response(noisy, 0x02, read_model)) == "complete 10");
+    CHECK(describe_consumed(p::frame_rtu_response(noisy, 0x02, read_model)) == "complete 10");
 }
 
 TEST_CASE("rtu: garbage then a reply, delivered in chunks as a line worker reads") {
@@ -213,20 +205,20 @@ TEST_CASE("rtu: garbage then a reply, delivered in chunks as a line worker reads
 TEST_CASE("rtu: wrong address, wrong function, bad CRC, unexpected byte count") {
     // A well-formed reply from device 3 while device 2 was asked.
     const Bytes from_3 = p::encode_rtu(0x03, Bytes{0x03, 0x02, 0x0A, 0x20});
-    CHECK(describe(p::frame_rtu_response(from_3, 0x02, read_model)) == "malformed wrong_address 7");
+    CHECK(describe_consumed(p::frame_rtu_response(from_3, 0x02, read_model)) == "malformed wrong_address 7");
     // Device 2 answers another function.
     const Bytes fc04 = p::encode_rtu(0x02, Bytes{0x04, 0x02, 0x0A, 0x20});
-    CHECK(describe(p::frame_rtu_response(fc04, 0x02, read_model)) == "malformed wrong_function 7");
+    CHECK(describe_consumed(p::frame_rtu_response(fc04, 0x02, read_model)) == "malformed wrong_function 7");
     const Bytes exception_84 = p::encode_rtu(0x02, Bytes{0x84, 0x02});
-    CHECK(describe(p::frame_rtu_response(exception_84, 0x02, read_model)) == "malformed wrong_function 5");
+    CHECK(describe_consumed(p::frame_rtu_response(exception_84, 0x02, read_model)) == "malformed wrong_function 5");
     // Two registers where one was asked: the byte count gives it away at once.
     const Bytes two_regs = p::encode_rtu(0x02, Bytes{0x03, 0x04, 0x0A, 0x20, 0x00, 0x00});
-    CHECK(describe(p::frame_rtu_response(two_regs, 0x02, read_model)) == "malformed unexpected_reply 9");
-    CHECK(describe(p::frame_rtu_response(ByteView(two_regs).first(3), 0x02, read_model)) ==
+    CHECK(describe_consumed(p::frame_rtu_response(two_regs, 0x02, read_model)) == "malformed unexpected_reply 9");
+    CHECK(describe_consumed(p::frame_rtu_response(ByteView(two_regs).first(3), 0x02, read_model)) ==
           "malformed unexpected_reply 3");
     // A request whose reply could not fit an ADU (200 registers).
     const p::Request too_many = p::ReadRegistersRequest{0x03, 0, 200};
-    CHECK(describe(p::frame_rtu_response(Bytes{0x02, 0x03, 0x90}, 0x02, too_many)) == "malformed oversize 3");
+    CHECK(describe_consumed(p::frame_rtu_response(Bytes{0x02, 0x03, 0x90}, 0x02, too_many)) == "malformed oversize 3");
 
     // Every byte of the reply corrupted, one bit at a time: never a reply.
     for (std::size_t i = 0; i < read_model_reply.size(); ++i) {
@@ -239,31 +231,31 @@ TEST_CASE("rtu: wrong address, wrong function, bad CRC, unexpected byte count") 
             if (i == 0) CHECK(r.error == p::DecodeError::wrong_address);
             // 0x83 is the exception of FC03: then a 5-byte exception with a bad CRC.
             if (i == 1) CHECK(r.error == (bit == 7 ? p::DecodeError::bad_crc : p::DecodeError::wrong_function));
-            if (i >= 3) CHECK(describe(r) == "malformed bad_crc 7");
+            if (i >= 3) CHECK(describe_consumed(r) == "malformed bad_crc 7");
         }
     }
     // Noise, then a corrupted reply: the more telling reason (bad CRC) is reported.
     Bytes corrupted = read_model_reply;
     corrupted[4] = 0x21;
-    CHECK(describe(p::frame_rtu_response(concat({Bytes{0x55, 0x00}, corrupted}), 0x02, read_model)) ==
+    CHECK(describe_consumed(p::frame_rtu_response(concat({Bytes{0x55, 0x00}, corrupted}), 0x02, read_model)) ==
           "malformed bad_crc 9");
 }
 
 TEST_CASE("rtu: bytes before a partial reply are dropped, then the reply completes") {
     const Bytes rx = concat({Bytes{0x55, 0xAA, 0x13}, ByteView(read_model_reply).first(4)});
     const auto first = p::frame_rtu_response(rx, 0x02, read_model);
-    CHECK(describe(first) == "malformed wrong_address 3");
-    CHECK(describe(p::frame_rtu_response(ByteView(rx).subspan(3), 0x02, read_model)) == "need_more");
+    CHECK(describe_consumed(first) == "malformed wrong_address 3");
+    CHECK(describe_consumed(p::frame_rtu_response(ByteView(rx).subspan(3), 0x02, read_model)) == "need_more");
 }
 
 TEST_CASE("rtu: local echo is the caller's job; reads and multiple writes survive it anyway") {
     // Echo of an FC03 request carries byte "count" 0x06: it cannot be the reply.
     const auto read = p::frame_rtu_response(concat({read_model_request, read_model_reply}), 0x02, read_model);
-    CHECK(describe(read) == "complete 15");
+    CHECK(describe_consumed(read) == "complete 15");
     CHECK(read.value.pdu == Bytes{0x03, 0x02, 0x0A, 0x20});
     // Echo of an FC10 request: its first 8 bytes fail the CRC of an 8-byte reply.
     const auto write = p::frame_rtu_response(concat({write_model_request, write_model_reply}), 0x02, write_model);
-    CHECK(describe(write) == "complete 19");
+    CHECK(describe_consumed(write) == "complete 19");
     CHECK(write.value.pdu == Bytes{0x10, 0x06, 0x00, 0x00, 0x01});
     // FC06: echo and reply are the same bytes (seed 003 shows FC06 replies equal to the
     // requests), so the echo would be taken for the reply. This is why the line worker
@@ -271,7 +263,7 @@ TEST_CASE("rtu: local echo is the caller's job; reads and multiple writes surviv
     const Bytes init_request = {0x01, 0x06, 0x01, 0x00, 0x00, 0x01, 0x49, 0xF6};
     const p::Request init = p::WriteSingleRegisterRequest{0x0100, 1};
     const auto echo = p::frame_rtu_response(concat({init_request, exception_reply}), 0x01, init);
-    CHECK(describe(echo) == "complete 8");
+    CHECK(describe_consumed(echo) == "complete 8");
     CHECK(echo.value.pdu == Bytes(init_request.begin() + 1, init_request.end() - 2));
 }
 
@@ -279,10 +271,10 @@ TEST_CASE("rtu: broadcasts are never answered") {
     const Bytes anything = {0x00, 0x10, 0x06, 0x30, 0x00, 0x03, 0x41, 0x47};
     for (const std::uint8_t broadcast : {p::modbus_broadcast_address, p::excd_broadcast_address}) {
         CAPTURE(static_cast<int>(broadcast));
-        CHECK(describe(p::frame_rtu_response({}, broadcast, write_model)) == "need_more");
-        CHECK(describe(p::frame_rtu_response(anything, broadcast, write_model)) == "malformed unexpected_reply 8");
+        CHECK(describe_consumed(p::frame_rtu_response({}, broadcast, write_model)) == "need_more");
+        CHECK(describe_consumed(p::frame_rtu_response(anything, broadcast, write_model)) == "malformed unexpected_reply 8");
         const Bytes would_be_reply = p::encode_rtu(broadcast, Bytes{0x10, 0x06, 0x00, 0x00, 0x01});
-        CHECK(describe(p::frame_rtu_response(would_be_reply, broadcast, write_model)) ==
+        CHECK(describe_consumed(p::frame_rtu_response(would_be_reply, broadcast, write_model)) ==
               "malformed unexpected_reply 8");
     }
 }
@@ -292,13 +284,13 @@ TEST_CASE("rtu: replies to opaque requests are framed by the shortest CRC-valid 
     const Bytes reply = p::encode_rtu(0x02, Bytes{0x11, 0x03, 0x42, 0xFF, 0x07});
     for (std::size_t len = 0; len < reply.size(); ++len) {
         CAPTURE(len);
-        CHECK(describe(p::frame_rtu_response(ByteView(reply).first(len), 0x02, report_id)) == "need_more");
+        CHECK(describe_consumed(p::frame_rtu_response(ByteView(reply).first(len), 0x02, report_id)) == "need_more");
     }
     const auto r = p::frame_rtu_response(concat({reply, Bytes{0x02, 0x11}}), 0x02, report_id);
-    CHECK(describe(r) == "complete 8");
+    CHECK(describe_consumed(r) == "complete 8");
     CHECK(r.value.pdu == Bytes{0x11, 0x03, 0x42, 0xFF, 0x07});
     const Bytes exception = p::encode_rtu(0x02, Bytes{0x91, 0x01});
-    CHECK(describe(p::frame_rtu_response(exception, 0x02, report_id)) == "complete 5");
+    CHECK(describe_consumed(p::frame_rtu_response(exception, 0x02, report_id)) == "complete 5");
     // 256 bytes and still no CRC match: not a reply.
     Bytes endless = {0x02, 0x11};
     std::mt19937 rng(11U);
@@ -327,25 +319,25 @@ TEST_CASE("rtu: frame_rtu_request") {
         CAPTURE(hex(request));
         for (std::size_t len = 0; len < request.size(); ++len) {
             CAPTURE(len);
-            CHECK(describe(p::frame_rtu_request(ByteView(request).first(len))) == "need_more");
+            CHECK(describe_consumed(p::frame_rtu_request(ByteView(request).first(len))) == "need_more");
         }
         const auto r = p::frame_rtu_request(request);
-        CHECK(describe(r) == "complete " + std::to_string(request.size()));
+        CHECK(describe_consumed(r) == "complete " + std::to_string(request.size()));
         CHECK(p::encode_rtu(r.value.address, r.value.pdu) == request);
     }
     // Pipelined: the first request only, then the second from where it ended.
     const Bytes two = concat({read_model_request, write_model_request});
     const auto first = p::frame_rtu_request(two);
-    CHECK(describe(first) == "complete 8");
-    CHECK(describe(p::frame_rtu_request(ByteView(two).subspan(first.consumed))) == "complete 11");
+    CHECK(describe_consumed(first) == "complete 8");
+    CHECK(describe_consumed(p::frame_rtu_request(ByteView(two).subspan(first.consumed))) == "complete 11");
     // Garbage before a request.
-    CHECK(describe(p::frame_rtu_request(concat({Bytes{0xFF, 0x00}, read_model_request}))) == "complete 10");
+    CHECK(describe_consumed(p::frame_rtu_request(concat({Bytes{0xFF, 0x00}, read_model_request}))) == "complete 10");
     // Function code 0 or with the exception flag cannot start a request.
     // (the last byte may still be the address of a request that follows).
-    CHECK(describe(p::frame_rtu_request(Bytes{0x02, 0x83})) == "malformed bad_value 1");
-    CHECK(describe(p::frame_rtu_request(Bytes{0x02, 0x00, 0x83, 0x80})) == "malformed bad_value 3");
+    CHECK(describe_consumed(p::frame_rtu_request(Bytes{0x02, 0x83})) == "malformed bad_value 1");
+    CHECK(describe_consumed(p::frame_rtu_request(Bytes{0x02, 0x00, 0x83, 0x80})) == "malformed bad_value 3");
     // Address 0 followed by a valid function code is a broadcast request arriving.
-    CHECK(describe(p::frame_rtu_request(Bytes{0x02, 0x00, 0x05, 0x80})) == "malformed bad_value 1");
+    CHECK(describe_consumed(p::frame_rtu_request(Bytes{0x02, 0x00, 0x05, 0x80})) == "malformed bad_value 1");
     // A byte count that makes the ADU longer than 256 bytes.
     const auto oversize = p::frame_rtu_request(Bytes{0x02, 0x10, 0x00, 0x00, 0x00, 0x7F, 0xFE});
     CHECK(oversize.malformed());

@@ -38,4 +38,15 @@ protocol::Bytes parse_hex(const std::string& spaced_hex) {
     return out;
 }
 
+std::string hex(protocol::ByteView bytes) {
+    static constexpr char digits[] = "0123456789ABCDEF";
+    std::string out;
+    for (const auto b : bytes) {
+        if (!out.empty()) out.push_back(' ');
+        out.push_back(digits[b >> 4]);
+        out.push_back(digits[b & 0x0F]);
+    }
+    return out;
+}
+
 }  // namespace fieldbridge::test

@@ -26,4 +26,7 @@ struct Vector {
 /// "02 10 06 00" -> bytes.
 [[nodiscard]] protocol::Bytes parse_hex(const std::string& spaced_hex);
 
+/// bytes -> "02 10 06 00" (upper-case, for failure messages).
+[[nodiscard]] std::string hex(protocol::ByteView bytes);
+
 }  // namespace fieldbridge::test

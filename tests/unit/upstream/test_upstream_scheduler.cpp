@@ -4,17 +4,18 @@
 #include <vector>
 
 #include "northbound/upstream/upstream_scheduler.hpp"
+#include "upstream_test_support.hpp"
 
 using namespace fieldbridge;
 using namespace fieldbridge::northbound::upstream;
 using protocol::Bytes;
+using fbtest::mode_read;
 using std::chrono::milliseconds;
 
 namespace {
 
 const Bytes counter_select_1{0x10, 0x08, 0x83, 0x00, 0x02, 0x04, 0x00, 0x00, 0x00, 0x01};
 const Bytes counter_read{0x03, 0x08, 0x83, 0x00, 0x06};
-const Bytes mode_read{0x03, 0x08, 0x89, 0x00, 0x01};
 const Bytes stop_cmd{0x06, 0x4E, 0x20, 0x00, 0x01};
 const Bytes speed_cmd{0x06, 0x4E, 0xE8, 0x00, 0x64};
 

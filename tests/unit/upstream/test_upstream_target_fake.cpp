@@ -13,11 +13,6 @@ using namespace fieldbridge::northbound::upstream;
 using namespace fbtest;
 using std::chrono::milliseconds;
 
-namespace {
-ClientRef client(std::uint64_t id) { return ClientRef{id, {}}; }
-
-const Bytes mode_read = hex("03 08 89 00 01");
-}  // namespace
 
 TEST_CASE("no reply within response_timeout: 0x0B; an expired command is never sent") {
     asio::io_context io;

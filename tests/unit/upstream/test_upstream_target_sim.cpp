@@ -17,8 +17,6 @@ using std::chrono::milliseconds;
 
 namespace {
 
-ClientRef client(std::uint64_t id) { return ClientRef{id, {}}; }
-
 /// Seed 004 sections 3.1-3.3 as printed (MBAP header included), as in
 /// tests/integration/sim/test_r6_tcp.py.
 const std::vector<std::pair<const char*, const char*>> printed{

@@ -51,6 +51,14 @@ struct Answer {
 };
 [[nodiscard]] fieldbridge::northbound::PduHandler capture(std::shared_ptr<Answer> answer);
 
+/// A client reference with only an id (no connection behind it).
+[[nodiscard]] inline fieldbridge::northbound::ClientRef client(std::uint64_t id) {
+    return fieldbridge::northbound::ClientRef{id, {}};
+}
+
+/// R6 (seed 004): read the mode register 0x0889, one register.
+inline const Bytes mode_read{0x03, 0x08, 0x89, 0x00, 0x01};
+
 [[nodiscard]] Bytes hex(const std::string& text);
 [[nodiscard]] std::string to_hex(const Bytes& bytes);
 

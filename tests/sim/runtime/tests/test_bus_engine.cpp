@@ -1,9 +1,9 @@
 #include <doctest/doctest.h>
 
-#include <spdlog/sinks/null_sink.h>
 
 #include "bus_engine.hpp"
 #include "fake_device.hpp"
+#include "null_log.hpp"
 
 namespace fieldbridge::sim::runtime {
 namespace {
@@ -22,9 +22,7 @@ const Bytes read_status{0x02, 0x04, 0x03, 0x01, 0x00, 0x01, 0x60, 0x7D};
 const Bytes broadcast_move{0x00, 0x10, 0x06, 0x30, 0x00, 0x03, 0x06, 0x0C,
                            0x80, 0x1F, 0x40, 0x00, 0x01, 0x3C, 0xA4};
 
-std::shared_ptr<spdlog::logger> null_log() {
-    return std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::null_sink_mt>());
-}
+using test::null_log;
 
 struct Bench {
     explicit Bench(bool wire_time, std::vector<std::unique_ptr<BusDevice>> devices = {}) {

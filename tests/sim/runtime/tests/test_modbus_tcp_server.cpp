@@ -6,18 +6,16 @@
 #include <asio/post.hpp>
 #include <asio/read.hpp>
 #include <asio/write.hpp>
-#include <spdlog/sinks/null_sink.h>
 
 #include "modbus_tcp_server.hpp"
+#include "null_log.hpp"
 
 namespace fieldbridge::sim::runtime {
 namespace {
 
 using protocol::Bytes;
 
-std::shared_ptr<spdlog::logger> null_log() {
-    return std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::null_sink_mt>());
-}
+using test::null_log;
 
 /// A server on an ephemeral loopback port, run on its own thread for the test.
 struct Running {
