@@ -55,7 +55,7 @@ constexpr std::uint16_t ralarm = 0x02D6;
     return d;
 }
 
-[[nodiscard]] std::shared_ptr<const RegisterMap> build_map() {
+[[nodiscard]] std::shared_ptr<const RegisterMap> excd_register_map() {
     constexpr auto rw = Access::read_write;
     constexpr auto w = Access::write;
     constexpr auto r = Access::read;
@@ -149,7 +149,7 @@ constexpr std::uint16_t ralarm = 0x02D6;
     return std::make_shared<const RegisterMap>(std::move(defs));
 }
 
-[[nodiscard]] WireFunctions wire_functions() {
+[[nodiscard]] WireFunctions excd_wire_functions() {
     // Seed 002 §2: FC03, FC06, FC10 only.
     return WireFunctions{{protocol::fc::read_holding_registers, protocol::fc::write_single_register,
                           protocol::fc::write_multiple_registers},
@@ -168,7 +168,7 @@ constexpr std::uint16_t ralarm = 0x02D6;
 }  // namespace
 
 ExcdProfile::ExcdProfile(const ProfileOptions& options)
-    : ModbusProfile(build_map(), wire_functions(), options, options.word_order) {}
+    : ModbusProfile(excd_register_map(), excd_wire_functions(), options, options.word_order) {}
 
 std::optional<ExceptionCode> ExcdProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
                                                       std::int64_t value, const RegisterImage& /*image*/) const {

@@ -79,7 +79,7 @@ void check_block(const GenericBlock& b) {
     return std::make_shared<const RegisterMap>(std::move(defs));
 }
 
-[[nodiscard]] WireFunctions wire_functions() {
+[[nodiscard]] WireFunctions generic_wire_functions() {
     namespace fc = protocol::fc;
     return WireFunctions{{fc::read_coils, fc::read_discrete_inputs, fc::read_holding_registers,
                           fc::read_input_registers, fc::write_single_coil, fc::write_single_register,
@@ -90,7 +90,7 @@ void check_block(const GenericBlock& b) {
 }  // namespace
 
 GenericProfile::GenericProfile(const ProfileOptions& options)
-    : ModbusProfile(build_map(options.blocks), wire_functions(), options, WordOrder::high_first) {}
+    : ModbusProfile(build_map(options.blocks), generic_wire_functions(), options, WordOrder::high_first) {}
 
 std::vector<PollUnit> GenericProfile::poll_units() const {
     std::vector<PollUnit> units;

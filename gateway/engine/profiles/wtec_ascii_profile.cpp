@@ -132,7 +132,7 @@ void sources_of(Table table, std::uint16_t address, std::array<bool, src_count>&
     return item;
 }
 
-[[nodiscard]] protocol::Response failure(std::uint8_t function, ExceptionCode code) {
+[[nodiscard]] protocol::Response exception_reply(std::uint8_t function, ExceptionCode code) {
     return protocol::ExceptionResponse{function, code};
 }
 
@@ -417,15 +417,15 @@ protocol::Response WtecAsciiProfile::respond(const protocol::Request& request, s
     const std::uint8_t function = protocol::function_of(request);
     const std::optional<RequestSpan> span = request_span(request);
     if (!span || replies.empty() || replies.size() != to_line(request, image).size()) {
-        return failure(function, ExceptionCode::gateway_target_failed);
+        return exception_reply(function, ExceptionCode::gateway_target_failed);
     }
     for (const Reply& reply : replies) {
         const auto* answer = std::get_if<wtec::Reply>(&reply);
         if (answer == nullptr || std::holds_alternative<wtec::NotHomed>(*answer)) {
-            return failure(function, ExceptionCode::gateway_target_failed);
+            return exception_reply(function, ExceptionCode::gateway_target_failed);
         }
         if (span->write && !std::holds_alternative<wtec::Ack>(*answer)) {
-            return failure(function, ExceptionCode::gateway_target_failed);
+            return exception_reply(function, ExceptionCode::gateway_target_failed);
         }
     }
     if (span->write) {
@@ -439,7 +439,7 @@ protocol::Response WtecAsciiProfile::respond(const protocol::Request& request, s
     for (std::size_t a = span->address; a < std::size_t{span->address} + span->count; ++a) {
         const auto v = image.value(span->table, static_cast<std::uint16_t>(a));
         if (!v) {
-            return failure(function, ExceptionCode::gateway_target_failed);
+            return exception_reply(function, ExceptionCode::gateway_target_failed);
         }
         values.push_back(*v);
     }

@@ -8,7 +8,7 @@ namespace fieldbridge::engine {
 
 namespace {
 
-[[nodiscard]] WireFunctions wire_functions() {
+[[nodiscard]] WireFunctions wtec_rtu_wire_functions() {
     // Seed 003 §2.1.1: "常见功能码有 03、06"; FC16 is translated to FC06s.
     return WireFunctions{{protocol::fc::read_holding_registers, protocol::fc::write_single_register,
                           protocol::fc::write_multiple_registers},
@@ -18,7 +18,7 @@ namespace {
 }  // namespace
 
 WtecRtuProfile::WtecRtuProfile(const ProfileOptions& options)
-    : ModbusProfile(std::make_shared<const RegisterMap>(wtec_uniform_defs(false)), wire_functions(), options,
+    : ModbusProfile(std::make_shared<const RegisterMap>(wtec_uniform_defs(false)), wtec_rtu_wire_functions(), options,
                     WordOrder::high_first) {}
 
 std::vector<PollUnit> WtecRtuProfile::poll_units() const {

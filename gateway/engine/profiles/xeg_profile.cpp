@@ -18,7 +18,7 @@ constexpr std::uint16_t di_first = 0x0000;   // IN1-IN6, START, (unused)
 constexpr std::uint16_t do_first = 0x0010;   // POS HOLD BUSY ALM1 ALM2 CHK1 CHK2 CHK3
 constexpr std::uint16_t do_alm1 = 0x0013;
 constexpr std::uint16_t do_alm2 = 0x0014;
-constexpr std::uint16_t position = 0x0300;   // 0.01 mm
+constexpr std::uint16_t actual_position = 0x0300;   // 0.01 mm
 constexpr std::uint16_t status = 0x0301;     // 0-7, §3.2
 constexpr std::uint16_t firmware = 0x0303;   // 0x0303-0x0306, §3.2
 constexpr std::uint16_t model = 0x0600;
@@ -64,12 +64,12 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
     return d;
 }
 
-[[nodiscard]] std::shared_ptr<const RegisterMap> build_map() {
+[[nodiscard]] std::shared_ptr<const RegisterMap> xeg_register_map() {
     using enum Table;
     std::vector<RegisterDef> defs{
         reg(discrete_inputs, di_first, "DI", Access::read, 0, 1, 8),
         reg(discrete_inputs, do_first, "DO", Access::read, 0, 1, 8),
-        reg(input, position, "position", Access::read),
+        reg(input, actual_position, "position", Access::read),
         reg(input, status, "status", Access::read),
         reg(input, firmware, "firmware", Access::read, 0, 0xFFFF, 4),
     };
@@ -98,7 +98,7 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
     return std::make_shared<const RegisterMap>(std::move(defs));
 }
 
-[[nodiscard]] WireFunctions wire_functions() {
+[[nodiscard]] WireFunctions xeg_wire_functions() {
     // Seed 001 §4.1 function code table; FC06 is accepted northbound and translated.
     return WireFunctions{{protocol::fc::read_discrete_inputs, protocol::fc::read_holding_registers,
                           protocol::fc::read_input_registers, protocol::fc::write_single_register,
@@ -155,7 +155,7 @@ std::string_view xeg_status_name(std::uint16_t value) noexcept {
 }
 
 XegProfile::XegProfile(const ProfileOptions& options)
-    : ModbusProfile(build_map(), wire_functions(), options, WordOrder::high_first) {}
+    : ModbusProfile(xeg_register_map(), xeg_wire_functions(), options, WordOrder::high_first) {}
 
 std::optional<ExceptionCode> XegProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
                                                      std::int64_t value, const RegisterImage& image) const {
@@ -181,7 +181,7 @@ std::vector<PollUnit> XegProfile::poll_units() const {
     // Spec §5: model and firmware at start, status fast, I/O slower.
     add(units_for(Table::holding, model, 1, PollClass::startup));
     add(units_for(Table::input, firmware, 4, PollClass::startup));
-    add(units_for(Table::input, position, 2, PollClass::fast, true));
+    add(units_for(Table::input, actual_position, 2, PollClass::fast, true));
     // 0x0008-0x000F is a hole: two FC02 reads, never one across it.
     add(units_for(Table::discrete_inputs, di_first, 8, PollClass::slow));
     add(units_for(Table::discrete_inputs, do_first, 8, PollClass::slow));
@@ -222,7 +222,7 @@ DecodedState XegProfile::decode_state(const RegisterImage& image) const {
         state.fields.push_back({"status", std::string{xeg_status_name(*s)}, ""});
         state.fields.push_back({"status_code", std::int64_t{*s}, ""});
     }
-    if (const auto p = image.value(Table::input, position)) {
+    if (const auto p = image.value(Table::input, actual_position)) {
         state.fields.push_back({"position_mm", static_cast<double>(*p) / 100.0, "mm"});
     }
     if (const auto m = image.value(Table::holding, model)) {

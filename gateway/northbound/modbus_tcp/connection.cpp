@@ -1,6 +1,7 @@
 // One Modbus TCP client connection. MBAP layout: Modbus Messaging on TCP/IP
 // Implementation Guide V1.0b section 3.1.3 (protocol/mbap_frame.hpp frames it).
 #include "northbound/modbus_tcp/connection.hpp"
+#include "northbound/modbus_tcp/server_log.hpp"
 
 #include <asio/post.hpp>
 #include <asio/write.hpp>
@@ -18,11 +19,6 @@ namespace {
 
 using engine::LogLevel;
 using Clock = std::chrono::steady_clock;
-
-template <class... Args>
-void log(const engine::LogSink& sink, LogLevel level, fmt::format_string<Args...> format, Args&&... args) {
-    if (sink.enabled(level)) sink(level, fmt::format(format, std::forward<Args>(args)...));
-}
 
 /// Appends one MBAP frame (header + PDU) to @p out without a temporary buffer:
 /// responses of one connection are gathered into one write.

@@ -1,4 +1,5 @@
 #include "northbound/modbus_tcp/server.hpp"
+#include "northbound/modbus_tcp/server_log.hpp"
 
 #include <algorithm>
 #include <asio/steady_timer.hpp>
@@ -18,11 +19,6 @@ using Clock = std::chrono::steady_clock;
 constexpr auto refusal_log_interval = std::chrono::seconds{10};
 /// Out of file descriptors or memory: accepting again at once would spin.
 constexpr auto accept_retry_delay = std::chrono::milliseconds{100};
-
-template <class... Args>
-void log(const engine::LogSink& sink, LogLevel level, fmt::format_string<Args...> format, Args&&... args) {
-    if (sink.enabled(level)) sink(level, fmt::format(format, std::forward<Args>(args)...));
-}
 
 [[nodiscard]] ServerLimits usable(ServerLimits limits) {
     limits.max_outstanding = std::clamp<std::size_t>(limits.max_outstanding, 1, 0xFFFF);
