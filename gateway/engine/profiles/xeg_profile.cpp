@@ -74,11 +74,11 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
         reg(input, firmware, "firmware", Access::read, 0, 0xFFFF, 4),
     };
     // §3 gives 0-2660 for the model; check_value() narrows it to the §3.3 list.
-    RegisterDef type = reg(holding, model, "EG type", Access::read_write, 0, 2660);
-    // Writing the model reconfigures the controller for another gripper (the quick
-    // start of Appendix 1 does it once): a set-up action, protected like an ID.
-    type.protect = true;
-    defs.push_back(std::move(type));
+    // Writable like any holding register: it is the first step of commissioning
+    // (Appendix 1, scenario 1) and changes nothing about communication (the ID is a
+    // rotary switch, the baud rate fixed), so it is not among the protected
+    // registers of spec §4 (device ID, flash save, baud / mode).
+    defs.push_back(reg(holding, model, "EG type", Access::read_write, 0, 2660));
     // §3 gives the trigger as 1-63 (§3.4.1 says 0-63: 0 would trigger nothing).
     defs.push_back(motion(reg(holding, 0x0601, "trigger", Access::read_write, 1, 63), true));
     defs.push_back(motion(reg(holding, 0x0610, "reset", Access::read_write, 0, 1), true));
@@ -194,6 +194,24 @@ void XegProfile::on_device_exception(const protocol::Request& /*sent*/, Exceptio
     if (code == ExceptionCode::server_device_failure) {
         result.follow_up = ModbusPayload{protocol::ReadExceptionStatusRequest{}};
     }
+}
+
+ApplyResult XegProfile::apply(const Payload& sent, const Reply& reply, RegisterImage& image, TimePoint now) const {
+    ApplyResult result = ModbusProfile::apply(sent, reply, image, now);
+    const auto* payload = std::get_if<ModbusPayload>(&sent);
+    if (result.status != ApplyStatus::applied || payload == nullptr || result.follow_up) {
+        return result;
+    }
+    // An acknowledged model write is already in the image (the ranges of the new
+    // model apply from the next request on); read it back as Appendix 1 does
+    // (scenario 3), so the image holds what the controller took.
+    const std::optional<RequestSpan> span = request_span(payload->request);
+    if (span && span->write && span->table == Table::holding && span->address <= model &&
+        std::size_t{span->address} + span->count > model) {
+        result.follow_up =
+            ModbusPayload{protocol::ReadRegistersRequest{protocol::fc::read_holding_registers, model, 1}};
+    }
+    return result;
 }
 
 void XegProfile::apply_other(const protocol::Request& sent, const protocol::Response& reply,

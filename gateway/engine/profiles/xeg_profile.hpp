@@ -5,7 +5,8 @@
 /// Map (seed 001 §3): discrete inputs 0x0000-0x0007 (DI) and 0x0010-0x0017 (DO);
 /// input registers 0x0300 position (0.01 mm), 0x0301 status 0-7, 0x0303-0x0306
 /// firmware; holding registers 0x0600 model, 0x0601 trigger, 0x0610 reset, 0x0620
-/// stop, 0x0630-0x0632 move, 0x0640-0x0646 expert. The controller knows FC02, 03,
+/// stop, 0x0630-0x0632 move, 0x0640-0x0646 expert (the model is writable, limited
+/// to the §3.3 codes). The controller knows FC02, 03,
 /// 04, 07 and 10 only (§4.1): a client's FC06 goes out as FC16 with one register.
 /// Move and expert values are checked against the model's ranges (§3.4.2).
 
@@ -51,6 +52,10 @@ public:
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+    /// As ModbusProfile::apply(); an acknowledged write of the model (0x0600) asks
+    /// for a read of it back (follow_up), as Appendix 1 does after writing it.
+    [[nodiscard]] ApplyResult apply(const Payload& sent, const Reply& reply, RegisterImage& image,
+                                    TimePoint now) const override;
 
 private:
     [[nodiscard]] std::optional<protocol::ExceptionCode> check_value(const RegisterDef& def,

@@ -10,6 +10,7 @@ argv: <test script> --gateway FIELDBRIDGE --sim FIELDBRIDGE_SIM [unittest option
 
 import json
 import os
+import re
 import signal
 import socket
 import struct
@@ -263,7 +264,7 @@ modbus_tcp:
     response_timeout: 300ms
     broadcast_unit: 100
     devices:
-      - {{name: gripper-1, type: hiwin-xeg, address: 2, unit_id: 1, allow_protected: true, command_ttl: 2s}}
+      - {{name: gripper-1, type: hiwin-xeg, address: 2, unit_id: 1, command_ttl: 2s}}
       - {{name: stepper-1, type: excd203mb, address: 3, unit_id: 2, command_ttl: 2s}}
       - {{name: gripper-2, type: wtec-ascii, address: 5, unit_id: 3, stroke: 20000, command_ttl: 2s}}
 {extra_devices_a}  - name: line-b
@@ -448,6 +449,31 @@ class CellTestCase(unittest.TestCase):
     def device_frames(self, bus, address):
         return self.sim_stats()["buses"][bus]["devices"][str(address)]["frames"]
 
+    def bus_trace(self, bus):
+        """The frames on `bus` in order, as ("request" | "reply", "02 03 ...") pairs, from
+        the simulator's trace log (start_cell(sim_extra=("--log-level", "trace")))."""
+        trace = []
+        for line in self.sim.log_text().splitlines():
+            found = _TRACE_LINE.search(line)
+            if found and found.group(1) == bus:
+                trace.append(("request" if found.group(2) == "request" else "reply", found.group(3)))
+        return trace
+
+    def assert_exchange(self, trace, request, reply, start=0):
+        """Index after the first `request` at or after `start` in `trace` that is followed
+        by `reply` (None: by no reply, as for a broadcast). The frames are spelled as in
+        the manuals' tables ("02 10 06 00 ...")."""
+        for i in range(start, len(trace)):
+            if trace[i] != ("request", request):
+                continue
+            following = trace[i + 1] if i + 1 < len(trace) else None
+            if reply is None and (following is None or following[0] == "request"):
+                return i + 1
+            if reply is not None and following == ("reply", reply):
+                return i + 2
+        self.fail("no request %s answered by %s on the line after frame %d; the line carried:\n%s"
+                  % (request, reply, start, "\n".join("%s %s" % f for f in trace[start:])))
+
     # -- assertions ------------------------------------------------------------------
 
     def assert_ok(self, reply):
@@ -473,6 +499,9 @@ class CellTestCase(unittest.TestCase):
             return last[0] == expected
         simlib.wait_until(check, timeout, interval=0.05)
         self.assertEqual(last[0], expected, "%s never became %r" % (what, expected))
+
+
+_TRACE_LINE = re.compile(r"(\S+): (request|reply \S+) ([0-9A-F]{2}(?: [0-9A-F]{2})*)$")
 
 
 def _read(path):

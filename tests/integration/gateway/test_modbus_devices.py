@@ -35,12 +35,17 @@ class XegQuickStart(gatewaylib.CellTestCase):
                         "XEG position and status after reset")
 
     def test_quick_start_through_the_gateway(self):
-        self.start_cell()
+        """Manual 001 Appendix 1 with a default device config (no allow_protected):
+        every write of the manual goes on the line as the manual's frame and is
+        answered with the manual's reply. Status reads are served from the image the
+        gateway polls (0x0300-0x0301 in one read), so their frames differ; their
+        values are the manual's."""
+        self.start_cell(sim_extra=("--log-level", "trace"))
         client = self.client()
-        # 1-4: write the model (FC16, protected: allowed on this device), read it back.
+        # 1-2: write the model XEG-32 (FC16), then 3-4: the gateway reads it back.
         self.assert_ok(client.write_registers(XEG_MODEL, [0x0A20], slave=XEG))
         self.assertEqual(self.read_holding(client, XEG_MODEL, 1, XEG), [0x0A20])
-        # 5-6: firmware V3.0.1.884.
+        # 5-6: firmware V3.0.1.884 (read at start).
         self.assertEqual(self.read_input(client, XEG_FIRMWARE, 4, XEG), [3, 0, 1, 884])
         # 7-13: reset, working, then idle at 32.00 mm. The manual reads "working" at
         # once; through the gateway a read in the first ~20 ms after the acknowledged
@@ -60,10 +65,42 @@ class XegQuickStart(gatewaylib.CellTestCase):
                              capture_output=True, text=True, timeout=30)
         self.assertEqual(out.returncode, 0, out.stdout + out.stderr)
         self.assertIn("[%d]: \t1700" % XEG_POSITION, out.stdout)
-        # 21-27 with unit 1 instead of the broadcast: move back to 32.00 mm, positioned.
-        self.assert_ok(client.write_registers(XEG_MOVE, [3200, 8000, 1], slave=XEG))
+        # 21-27: the move as a broadcast (the line's broadcast unit), then positioned
+        # at 32.00 mm.
+        self.assert_ok(client.write_registers(XEG_MOVE, [3200, 8000, 1], slave=BROADCAST))
         self.wait_value(lambda: self.read_input(client, XEG_POSITION, 2, XEG), [3200, POSITIONED],
-                        MOTION_TIMEOUT, "XEG position and status after the move")
+                        MOTION_TIMEOUT, "XEG position and status after the broadcast move")
+        # Frame for frame, in the manual's order (scenario numbers).
+        trace = self.bus_trace("line-a")
+        at = self.assert_exchange(trace, "02 04 03 03 00 04 01 BE",
+                                  "02 04 08 00 03 00 00 00 01 03 74 49 5E")                   # 5-6
+        at = self.assert_exchange(trace, "02 10 06 00 00 01 02 0A 20 D3 D8", "02 10 06 00 00 01 01 72")  # 1-2
+        at = self.assert_exchange(trace, "02 03 06 00 00 01 84 B1", "02 03 02 0A 20 FB 3C", at)  # 3-4
+        at = self.assert_exchange(trace, "02 10 06 10 00 01 02 00 01 17 F0", "02 10 06 10 00 01 00 B7",
+                                  at)                                                             # 7-8
+        at = self.assert_exchange(trace, "02 10 06 40 00 07 0E 00 00 03 E8 1F 40 01 F4 07 D0 00 64 00 01 E6 B8",
+                                  "02 10 06 40 00 07 80 A4", at)                                  # 14-15
+        self.assert_exchange(trace, "00 10 06 30 00 03 06 0C 80 1F 40 00 01 3C A4", None, at)   # 21-22
+
+    def test_model_write_limits_and_new_ranges(self):
+        """0x0600 takes the models of manual 001 section 3.3 only (0x03 locally, nothing
+        sent); after XEG-16 is written, a 32 mm move is out of range at once."""
+        self.start_cell(sim_extra=("--log-level", "trace"))
+        client = self.client()
+        self.assert_exception(client.write_registers(XEG_MODEL, [0x0A22], slave=XEG), 0x03)
+        self.assert_exception(client.write_register(XEG_MODEL, 0x1234, slave=XEG), 0x03)
+        model_writes = [f for f in self.bus_trace("line-a") if f[0] == "request" and f[1].startswith("02 10 06 00")]
+        self.assertEqual(model_writes, [])
+        # FC06 goes out as FC16 (the XEG has no FC06); the model is read back.
+        self.assert_ok(client.write_register(XEG_MODEL, 0x0A10, slave=XEG))
+        self.assert_exception(client.write_registers(XEG_MOVE, [3200, 6000, 1], slave=XEG), 0x03)
+        # 16 mm is in range: it goes to the controller, which refuses it (0x04) only
+        # because it has not been reset yet (manual 001 section 4.2.4, 0x07).
+        self.assert_exception(client.write_registers(XEG_MOVE, [1600, 6000, 1], slave=XEG), 0x04)
+        self.assertEqual(self.read_holding(client, XEG_MODEL, 1, XEG), [0x0A10])
+        trace = self.bus_trace("line-a")
+        at = self.assert_exchange(trace, "02 10 06 00 00 01 02 0A 10 D3 CC", "02 10 06 00 00 01 01 72")
+        self.assert_exchange(trace, "02 03 06 00 00 01 84 B1", "02 03 02 0A 10 FB 28", at)
 
     def test_fc06_is_sent_as_fc16_and_answered_as_fc06(self):
         self.start_cell()

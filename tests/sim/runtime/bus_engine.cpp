@@ -20,6 +20,18 @@ constexpr std::uint64_t gap_warnings = 10;
 /// not have it cut at 0.3 ms.
 constexpr auto resync_floor = std::chrono::milliseconds(2);
 
+/// "02 03 06 00 00 01 84 B1": the spelling of the manuals' frame tables, so a trace
+/// can be compared with them (and with tests/vectors) by eye or by a test.
+[[nodiscard]] std::string hex_bytes(const protocol::Bytes& bytes) {
+    std::string text;
+    text.reserve(bytes.size() * 3);
+    for (const std::uint8_t b : bytes) {
+        if (!text.empty()) text += ' ';
+        text += fmt::format("{:02X}", b);
+    }
+    return text;
+}
+
 }  // namespace
 
 BusEngine::BusEngine(BusSettings settings, std::vector<std::unique_ptr<BusDevice>> devices,
@@ -217,6 +229,9 @@ void BusEngine::handle_frame(const Attempt& attempt, Clock::time_point now) {
     rx_end_.erase(rx_end_.begin(), rx_end_.begin() + n);
 
     ++wire_.requests;
+    if (log_->should_log(spdlog::level::trace)) {
+        log_->trace("{}: request {}", settings_.name, hex_bytes(frame));
+    }
     note_silence(start);
     last_frame_end_ = end;
     if (faults_.decide_echo()) {
@@ -272,6 +287,10 @@ void BusEngine::handle_frame(const Attempt& attempt, Clock::time_point now) {
             continue;
         }
         auto out = damage(std::move(bytes), attempt.protocol, faults, slot->counters);
+        if (log_->should_log(spdlog::level::trace)) {
+            log_->trace("{}: reply {}@{} {}", settings_.name, slot->device->type(), slot->device->address(),
+                        hex_bytes(out));
+        }
         auto at = cursor + faults.delay;
         if (settings_.wire_time) {
             // A slave knows the request has ended only after 3.5 characters of

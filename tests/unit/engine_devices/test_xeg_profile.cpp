@@ -36,7 +36,7 @@ TEST_CASE("xeg: identity") {
     CHECK(x.profile.broadcast_address() == 0);
 }
 
-TEST_CASE("xeg: 0x01 for function codes the controller lacks, and for the protected model register") {
+TEST_CASE("xeg: 0x01 for function codes the controller lacks") {
     Xeg x;
     CHECK(x.check(read_bits(fp::fc::read_coils, 0, 8)) == ExceptionCode::illegal_function);
     CHECK(x.check(fp::WriteSingleCoilRequest{0, true}) == ExceptionCode::illegal_function);
@@ -44,14 +44,51 @@ TEST_CASE("xeg: 0x01 for function codes the controller lacks, and for the protec
     CHECK(x.check(fp::OpaqueRequest{0x2B, {0x0E, 0x01, 0x00}}) == ExceptionCode::illegal_function);
     // FC07 is the controller's own (seed 001 §4.2.4).
     CHECK_FALSE(x.check(fp::ReadExceptionStatusRequest{}));
-    // Writing the model reconfigures the controller: protected unless allowed.
-    CHECK(x.check(write_multiple(0x0600, {xeg_32})) == ExceptionCode::illegal_function);
-    fe::ProfileOptions allow;
-    allow.allow_protected = true;
-    const fe::XegProfile permissive{allow};
-    CHECK_FALSE(permissive.validate(write_multiple(0x0600, {xeg_32}), x.image));
-    // ... and only to a model the manual lists (§3.3).
-    CHECK(permissive.validate(write_multiple(0x0600, {0x0A22}), x.image) == ExceptionCode::illegal_data_value);
+}
+
+TEST_CASE("xeg: the model is writable with a default config, to the models of §3.3 only") {
+    // Appendix 1 scenario 1 writes it first: not a protected register (spec §4).
+    Xeg x;
+    REQUIRE_FALSE(x.options.allow_protected);
+    for (const std::uint16_t m : std::initializer_list<std::uint16_t>{0x0A10, 0x0A20, 0x0A21, 0x0A30, 0x0A40}) {
+        CHECK_FALSE(x.check(write_multiple(0x0600, {m})));
+        CHECK_FALSE(x.check(write_single(0x0600, m)));
+    }
+    for (const std::uint16_t m : std::initializer_list<std::uint16_t>{0x0000, 0x0A00, 0x0A22, 0x0A41, 0x0A64}) {
+        CHECK(x.check(write_multiple(0x0600, {m})) == ExceptionCode::illegal_data_value);
+    }
+    CHECK(x.check(write_multiple(0x0600, {0x0A65})) == ExceptionCode::illegal_data_value);  // above 2660
+}
+
+TEST_CASE("xeg: an acknowledged model write is read back and its ranges apply at once") {
+    Xeg x;
+    x.model(xeg_32);
+    CHECK_FALSE(x.check(write_single(0x0630, 3200)));
+    const auto sent = x.profile.to_line(write_single(0x0600, xeg_16), x.image);
+    REQUIRE(sent.size() == 1);
+    const auto result =
+        x.profile.apply(sent[0], modbus(fp::WriteMultipleResponse{0x10, 0x0600, 1}), x.image, t0());
+    CHECK(result.status == fe::ApplyStatus::applied);
+    // Appendix 1 scenario 3: FC03 0x0600 x1.
+    REQUIRE(result.follow_up.has_value());
+    REQUIRE(std::holds_alternative<fe::ModbusPayload>(*result.follow_up));
+    CHECK(std::get<fe::ModbusPayload>(*result.follow_up).request == read_holding(0x0600, 1));
+    // XEG-16 strokes 16 mm: 32.00 mm is out of range from now on.
+    CHECK(x.image.value(Table::holding, 0x0600) == xeg_16);
+    CHECK(x.check(write_single(0x0630, 3200)) == ExceptionCode::illegal_data_value);
+    CHECK_FALSE(x.check(write_single(0x0630, 1600)));
+    // The read back stores what the controller holds, and asks for nothing more.
+    const auto back = x.profile.apply(*result.follow_up, registers(0x03, {xeg_16}), x.image, t0());
+    CHECK_FALSE(back.follow_up.has_value());
+    // Other writes and a refused model write ask for no read.
+    CHECK_FALSE(x.profile
+                    .apply(fe::ModbusPayload{write_multiple(0x0630, {1000, 5000, 1})},
+                           modbus(fp::WriteMultipleResponse{0x10, 0x0630, 3}), x.image, t0())
+                    .follow_up.has_value());
+    const auto refused = x.profile.apply(sent[0], modbus(fp::ExceptionResponse{0x10, ExceptionCode::server_device_failure}),
+                                         x.image, t0());
+    REQUIRE(refused.follow_up.has_value());
+    CHECK(std::get<fe::ModbusPayload>(*refused.follow_up).request == fp::Request{fp::ReadExceptionStatusRequest{}});
 }
 
 TEST_CASE("xeg: 0x02 outside the map, across a hole, wrong table") {
@@ -123,7 +160,8 @@ TEST_CASE("xeg: classification") {
         CHECK_FALSE(c.urgent_stop);
     }
     const auto model = x.profile.classify(write_single(0x0600, xeg_32));
-    CHECK(model.protected_write);
+    CHECK(model.write);
+    CHECK_FALSE(model.protected_write);
     CHECK_FALSE(model.motion);
 }
 
