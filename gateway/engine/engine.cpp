@@ -23,6 +23,7 @@ Engine::Engine(asio::io_context& io, const config::Config& config, LogSink log, 
     for (const auto& line : config.lines) {
         LineEntry entry;
         entry.broadcast_unit = line.broadcast_unit;
+        entry.broadcast_share = line.broadcast_share;
         for (std::size_t i = 0; i < line.devices.size(); ++i) {
             const auto& device = line.devices[i];
             if (i == 0 || device.command_ttl < entry.broadcast_ttl) entry.broadcast_ttl = device.command_ttl;

@@ -47,6 +47,8 @@ struct LineEntry {
     /// The line's shortest command_ttl: a broadcast acts no later than any of its
     /// devices would accept a command.
     Duration broadcast_ttl = std::chrono::milliseconds{500};
+    /// Percent of the line's time its broadcasts may take (config broadcast_share).
+    unsigned broadcast_share = 10;
 };
 
 class Engine {
