@@ -37,7 +37,7 @@ TEST_CASE("request_scope fails closed: what it cannot derive touches every regis
     for (const std::uint8_t function : std::vector<std::uint8_t>{0x07, 0x0B, 0x0C, 0x11}) {
         CHECK(request_scope(Bytes{function}) == RequestScope{function, {}, {}});
     }
-    // FC16 (mask write) is derived: its one register.
+    // FC22 (0x16, mask write) is derived: its one register.
     CHECK(request_scope(Bytes{0x16, 0x4E, 0x20, 0xFF, 0xFF, 0x00, 0x01}) ==
           RequestScope{0x16, RegisterRange{0x4E20, 0x4E20}, {}});
     // Diagnostics, file records, FIFO, encapsulated transport, vendor codes, 0 and >= 0x80.
@@ -102,7 +102,7 @@ TEST_CASE("a deny rule matches any overlap with its register range") {
     CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x20})));
     CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x10})));  // ends at 0x1FF
     CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x07})));  // no registers: no match
-    // Fail closed: FC16 in the range, and what the server cannot derive, are denied.
+    // Fail closed: FC22 in the range, and what the server cannot derive, are denied.
     CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x16, 0x02, 0x01, 0xFF, 0xFF, 0, 1})));
     CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x16, 0x02, 0x04, 0xFF, 0xFF, 0, 1})));
     CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x15, 0x07, 0x06, 0, 1, 0, 0, 0, 1})));
