@@ -119,6 +119,7 @@ void set(T& target, const Field<T>& field) {
     if (raw.broadcast_unit.has_value()) {
         line.broadcast_unit = static_cast<std::uint8_t>(*raw.broadcast_unit);
     }
+    line.broadcast_share = narrow<unsigned>(raw.broadcast_share, line.broadcast_share);
     for (const auto& device : raw.devices.items) {
         line.devices.push_back(build_device(device));
     }

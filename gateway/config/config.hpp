@@ -223,6 +223,11 @@ struct LineConfig {
     static constexpr Range<std::int64_t> offline_after_range{1, 100};
     Backoff offline_backoff{seconds{1}, seconds{30}};
     std::optional<std::uint8_t> broadcast_unit;  ///< Modbus TCP unit that broadcasts on this line
+    /// Percent of the line's time its broadcasts may take (frame + t3.5 +
+    /// broadcast_delay each); a broadcast beyond it is refused with 0x06, so polls and
+    /// the other devices keep their rates.
+    unsigned broadcast_share = 10;
+    static constexpr Range<std::int64_t> broadcast_share_range{1, 100};
     std::vector<DeviceConfig> devices;
 
     /// Start + data + parity + stop bits.

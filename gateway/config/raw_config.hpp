@@ -148,6 +148,7 @@ struct RawLine : RawNode {
     Field<std::int64_t> offline_after;
     RawBackoff offline_backoff;
     Field<std::int64_t> broadcast_unit;
+    Field<std::int64_t> broadcast_share;
     RawSeq<RawDevice> devices;
 };
 

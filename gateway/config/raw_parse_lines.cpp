@@ -77,7 +77,7 @@ RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "port", "baud", "parity", "data_bits", "stop_bits", "rs485", "local_echo",
                          "response_timeout", "byte_timeout", "turnaround", "broadcast_delay", "read_retries", "offline_after",
-                         "offline_backoff", "broadcast_unit", "devices"},
+                         "offline_backoff", "broadcast_unit", "broadcast_share", "devices"},
                         sink);
     RawLine raw;
     map.fill(raw);
@@ -98,6 +98,7 @@ RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     raw.offline_after = read_int(map, "offline_after");
     raw.offline_backoff = parse_backoff(map.child("offline_backoff"), sink);
     raw.broadcast_unit = read_int(map, "broadcast_unit");
+    raw.broadcast_share = read_int(map, "broadcast_share");
     raw.devices = read_seq<RawDevice>(map, "devices", parse_device);
     return raw;
 }

@@ -93,6 +93,7 @@ void validate_lines(const RawConfig& raw, DiagnosticSink& sink) {
         if (line.broadcast_unit.has_value()) {
             check_range(sink, line.broadcast_unit, unit_id_range);
         }
+        check_range(sink, line.broadcast_share, LineConfig::broadcast_share_range);
         validate_devices(line, sink);
     }
 }

@@ -46,15 +46,18 @@ void ModbusTcpComponent::rebuild_routes(engine::Engine* engine) {
     serial_targets_.clear();
     if (engine != nullptr) {
         for (const auto& line : engine->lines()) {
+            std::vector<northbound::LineUnit> units;
             for (const auto& device : engine->devices()) {
                 if (device.line != line.worker->config().name) continue;
                 serial_targets_.push_back(
                     std::make_unique<northbound::SerialDeviceTarget>(io_, *device.agent, *line.worker));
                 routes.set(device.unit_id, *serial_targets_.back());
+                units.push_back(northbound::LineUnit{device.agent, device.unit_id});
             }
             if (line.broadcast_unit) {
                 serial_targets_.push_back(std::make_unique<northbound::LineBroadcastTarget>(
-                    io_, *line.worker, line.broadcast_addresses, line.broadcast_ttl));
+                    io_, *line.worker, std::move(units),
+                    northbound::BroadcastSettings{line.broadcast_ttl, line.broadcast_share}));
                 routes.set(*line.broadcast_unit, *serial_targets_.back());
             }
         }

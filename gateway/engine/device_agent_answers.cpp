@@ -8,20 +8,23 @@ namespace fieldbridge::engine {
 
 using protocol::ExceptionCode;
 
-ExceptionCode exception_for(OutcomeStatus status) noexcept {
+protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept {
+    using protocol::GatewayRefusal;
     switch (status) {
         case OutcomeStatus::timeout:
-        case OutcomeStatus::device_offline:
+        case OutcomeStatus::device_offline: return GatewayRefusal::no_answer;
+        case OutcomeStatus::expired: return GatewayRefusal::expired;
+        case OutcomeStatus::queue_full: return GatewayRefusal::busy;
         case OutcomeStatus::line_down:
-        case OutcomeStatus::expired: return ExceptionCode::gateway_target_failed;
-        case OutcomeStatus::queue_full: return ExceptionCode::server_device_busy;
+        case OutcomeStatus::cancelled: return GatewayRefusal::path_down;
         case OutcomeStatus::ok:  // an ok outcome without a usable reply
-        case OutcomeStatus::cancelled:
         case OutcomeStatus::broadcast_sent:
         case OutcomeStatus::invalid_request: break;
     }
-    return ExceptionCode::server_device_failure;
+    return GatewayRefusal::gateway_failure;
 }
+
+ExceptionCode exception_for(OutcomeStatus status) noexcept { return protocol::exception_code(refusal_for(status)); }
 
 protocol::Response exception_response(const protocol::Request& request, ExceptionCode code) {
     return protocol::ExceptionResponse{protocol::function_of(request), code};

@@ -8,15 +8,18 @@
 
 #include "engine/register_image.hpp"
 #include "engine/transaction.hpp"
+#include "protocol/gateway_exceptions.hpp"
 #include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::engine {
 
-/// Spec §4 and §3 rule 9: timeout / device_offline / line_down / expired -> 0x0B
-/// (gateway target failed to respond: the device did not answer, or a command's
-/// deadline passed before it could start); queue_full -> 0x06 (server busy: that
-/// device's queue is full); cancelled / invalid_request (and anything else that is
-/// not a reply) -> 0x04 (server failure: the gateway gave up on it).
+/// Spec §4 and §3 rule 9, through the gateway's one mapping
+/// (protocol/gateway_exceptions.hpp): timeout / device_offline -> no_answer (0x0B);
+/// expired -> expired (0x0B: a command's deadline passed before it could start);
+/// queue_full -> busy (0x06); line_down / cancelled -> path_down (0x0A: nothing was
+/// sent, the line is down or being shut down or reconfigured); anything else that is
+/// not a reply -> gateway_failure (0x04).
+[[nodiscard]] protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept;
 [[nodiscard]] protocol::ExceptionCode exception_for(OutcomeStatus status) noexcept;
 
 /// An exception under the client's own function code (an XEG FC06 that went out as

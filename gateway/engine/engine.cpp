@@ -23,17 +23,11 @@ Engine::Engine(asio::io_context& io, const config::Config& config, LogSink log, 
     for (const auto& line : config.lines) {
         LineEntry entry;
         entry.broadcast_unit = line.broadcast_unit;
+        entry.broadcast_share = line.broadcast_share;
         for (std::size_t i = 0; i < line.devices.size(); ++i) {
             const auto& device = line.devices[i];
             if (i == 0 || device.command_ttl < entry.broadcast_ttl) entry.broadcast_ttl = device.command_ttl;
-            if (!config::speaks_modbus(device.type)) continue;
-            const std::uint8_t address = config::broadcast_address(device.type);
-            if (std::find(entry.broadcast_addresses.begin(), entry.broadcast_addresses.end(), address) ==
-                entry.broadcast_addresses.end()) {
-                entry.broadcast_addresses.push_back(address);
-            }
         }
-        std::sort(entry.broadcast_addresses.begin(), entry.broadcast_addresses.end());
         entry.worker = std::make_unique<LineWorker>(io, line_worker_config(line), ports(serial_settings(line)), log_);
         for (std::size_t i = 0; i < line.devices.size(); ++i) {
             const auto& device = line.devices[i];

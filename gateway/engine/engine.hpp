@@ -41,12 +41,11 @@ struct LineEntry {
     std::unique_ptr<LineWorker> worker;
     std::vector<std::unique_ptr<DeviceAgent>> agents;  ///< by DeviceIndex
     std::optional<std::uint8_t> broadcast_unit;
-    /// Bus addresses a broadcast goes to: 0 for Modbus devices, 0xFF for the
-    /// EXCD203MB (seed 002 §5), both on a mixed line; WTEC ASCII devices take neither.
-    std::vector<std::uint8_t> broadcast_addresses;
     /// The line's shortest command_ttl: a broadcast acts no later than any of its
     /// devices would accept a command.
     Duration broadcast_ttl = std::chrono::milliseconds{500};
+    /// Percent of the line's time its broadcasts may take (config broadcast_share).
+    unsigned broadcast_share = 10;
 };
 
 class Engine {

@@ -2,12 +2,14 @@
 /// @file unit_target.hpp
 /// What a Modbus TCP unit ID leads to (spec §4): a serial device (its DeviceAgent), a
 /// line's broadcast unit, or a unit of an upstream Modbus TCP server (Huacheng R6
-/// pass-through). The server decodes MBAP, applies access control, and hands the PDU
-/// to the target of the unit; the target answers with a response PDU (normal or
+/// pass-through). The server decodes MBAP, applies access control, answers a function
+/// byte of 0 or >= 0x80 itself (exception 0x01, protocol/gateway_exceptions.hpp), and
+/// hands any other PDU to the target of the unit; the target answers with a response PDU (normal or
 /// exception) through the handler, exactly once, on the loop thread, never from
 /// inside handle().
 #include <cstdint>
 #include <functional>
+#include <span>
 
 #include "config/net_address.hpp"
 #include "protocol/bytes.hpp"
@@ -34,6 +36,9 @@ public:
     /// @p request_pdu is a complete PDU as received (function code first).
     virtual void handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
                         PduHandler done) = 0;
+    /// Units whose access rules this target's requests must pass too, besides its own
+    /// unit: a line's broadcast unit reaches every unit of its line.
+    [[nodiscard]] virtual std::span<const std::uint8_t> ruled_as() const noexcept { return {}; }
     /// The client's connection closed: drop its state, answer nothing more to it.
     virtual void client_closed(std::uint64_t /*connection*/) {}
 };

@@ -1,5 +1,5 @@
 // Request scope for access rules. Field offsets: Modbus Application Protocol
-// V1.1b3 section 6 (request PDUs of FC01-06, 0F, 10, 17).
+// V1.1b3 section 6 (request PDUs of FC01-06, 0F, 10, 16, 17).
 #include "northbound/modbus_tcp/access_control.hpp"
 
 #include <algorithm>
@@ -25,12 +25,26 @@ constexpr std::size_t single_write_min_size = 3;       // fc + address
 constexpr std::size_t rw_write_address_offset = 5;
 constexpr std::size_t rw_write_quantity_offset = 7;
 constexpr std::size_t rw_min_size = 9;  // fc + read address, quantity + write address, quantity
+constexpr std::uint8_t mask_write_register = 0x16;  // Modbus 6.16: fc + address + AND mask + OR mask
+
+/// What a request whose registers cannot be known touches, as far as the rules are
+/// concerned: everything (rules fail closed, docs/modbus-tcp.md).
+constexpr config::RegisterRange every_register{0x0000, 0xFFFF};
+
+/// Function codes that read no register and change nothing (Modbus 6.7, 6.9, 6.10,
+/// 6.13: read exception status, get comm event counter / log, report server ID).
+[[nodiscard]] bool touches_no_register(std::uint8_t function) noexcept {
+    return function == 0x07 || function == 0x0B || function == 0x0C || function == 0x11;
+}
 
 }  // namespace
 
 RequestScope request_scope(protocol::ByteView pdu) noexcept {
     RequestScope scope;
-    if (pdu.empty()) return scope;
+    if (pdu.empty()) {
+        scope.first = every_register;
+        return scope;
+    }
     scope.function = pdu[0];
     namespace fc = protocol::fc;
     switch (scope.function) {
@@ -46,6 +60,7 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
             break;
         case fc::write_single_coil:
         case fc::write_single_register:
+        case mask_write_register:
             if (pdu.size() >= single_write_min_size) scope.first = span(protocol::get_u16_be(pdu, address_offset), 1);
             break;
         case fc::read_write_multiple_registers:
@@ -56,8 +71,12 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
             }
             break;
         default:
-            break;  // FC07, diagnostics, vendor codes: no register range
+            if (touches_no_register(scope.function)) return scope;
+            break;  // FC08, 14, 15, 18, 2B, vendor codes: what they touch is not known
     }
+    // A PDU too short for its address fields, or a function code whose registers
+    // the server does not derive: it may touch any register.
+    if (!scope.first) scope.first = every_register;
     return scope;
 }
 

@@ -4,9 +4,12 @@
 /// request touches (function code and address ranges, read straight from the PDU's
 /// header fields) and whether the configured rules let the client do it.
 ///
-/// Pure: no I/O, no state. The PDU is not validated here; a PDU too short to carry
-/// its address fields has no range, and the rules treat it as a request without
-/// registers (the target then rejects it as malformed).
+/// Pure: no I/O, no state. The PDU is not validated here. Rules fail closed: a
+/// request whose registers the server cannot derive (a PDU too short for its address
+/// fields, FC08, 14, 15, 18, 2B, vendor codes) counts as touching every register
+/// (0x0000-0xFFFF), so a deny rule with a register range matches it and an allow
+/// rule with a narrower range does not. Only FC07, 0B, 0C and 11, which read no
+/// register and change nothing, have no range.
 #include <cstdint>
 #include <optional>
 
@@ -18,7 +21,8 @@ namespace fieldbridge::northbound::modbus_tcp {
 /// What a request touches.
 struct RequestScope {
     std::uint8_t function = 0;
-    /// FC01-06, 0F, 10: the addressed coils / inputs / registers. FC17: the read range.
+    /// FC01-06, 0F, 10: the addressed coils / inputs / registers; FC22 (0x16, mask write):
+    /// its register; FC17: the read range; unknown: 0x0000-0xFFFF; FC07, 0B, 0C, 11: none.
     std::optional<config::RegisterRange> first;
     /// FC17 only: the write range.
     std::optional<config::RegisterRange> second;

@@ -3,11 +3,13 @@
 #include "northbound/modbus_tcp/connection.hpp"
 #include "northbound/modbus_tcp/server_log.hpp"
 
+#include <algorithm>
 #include <asio/post.hpp>
 #include <asio/write.hpp>
 #include <cstring>
 #include <exception>
 #include <fmt/format.h>
+#include <span>
 #include <utility>
 
 #include "northbound/modbus_tcp/access_control.hpp"
@@ -147,20 +149,34 @@ void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, proto
     ConnectionContext& context = *context_;
     ++context.stats.requests;
     const RequestScope scope = request_scope(pdu);
-    if (!request_allowed(*context.config, client_.address, unit, scope)) {
+    UnitTarget* target = context.routes.find(unit);
+    // A broadcast unit answers for the units of its line: a request it may carry
+    // must be allowed for each of them too (docs/modbus-tcp.md, "Broadcast units").
+    const auto denied = [&] {
+        if (!request_allowed(*context.config, client_.address, unit, scope)) return true;
+        if (target == nullptr) return false;
+        const std::span<const std::uint8_t> also = target->ruled_as();
+        return std::any_of(also.begin(), also.end(), [&](std::uint8_t covered) {
+            return !request_allowed(*context.config, client_.address, covered, scope);
+        });
+    };
+    if (denied()) {
         ++context.stats.denied;
         log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} function {} denied by an access rule",
             peer_, unit, scope.function);
-        respond_exception(transaction_id, unit, scope.function,
-                          static_cast<std::uint8_t>(protocol::ExceptionCode::illegal_function));
+        respond_exception(transaction_id, unit, scope.function, protocol::GatewayRefusal::denied);
         return;
     }
-    UnitTarget* target = context.routes.find(unit);
     if (target == nullptr) {
         ++context.stats.unknown_unit;
         log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} has no route", peer_, unit);
-        respond_exception(transaction_id, unit, scope.function,
-                          static_cast<std::uint8_t>(protocol::ExceptionCode::gateway_path_unavailable));
+        respond_exception(transaction_id, unit, scope.function, protocol::GatewayRefusal::path_down);
+        return;
+    }
+    if (!protocol::is_function_code(scope.function)) {
+        // Function byte 0 or >= 0x80 (or an empty PDU): answered here, the same way for
+        // every kind of target.
+        respond_exception(transaction_id, unit, scope.function, protocol::GatewayRefusal::not_a_function);
         return;
     }
     const std::uint16_t index = free_slots_.back();
@@ -186,8 +202,7 @@ void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, proto
             peer_, e.what());
         if (slot.busy && slot.generation == generation) {
             complete(index, generation,
-                     protocol::Bytes{static_cast<std::uint8_t>(scope.function | protocol::fc::exception_flag),
-                                     static_cast<std::uint8_t>(protocol::ExceptionCode::server_device_failure)});
+                     protocol::exception_pdu(scope.function, protocol::GatewayRefusal::gateway_failure));
         }
     }
 }
@@ -211,8 +226,7 @@ void Connection::complete(std::uint16_t index, std::uint32_t generation, protoco
         log(context_->log, LogLevel::error,
             "Modbus TCP: the target of unit {} answered a PDU of {} bytes (1..{} allowed); sending exception 0x04",
             slot.unit, response_pdu.size(), protocol::max_pdu_size);
-        respond_exception(slot.transaction_id, slot.unit, slot.function,
-                          static_cast<std::uint8_t>(protocol::ExceptionCode::server_device_failure));
+        respond_exception(slot.transaction_id, slot.unit, slot.function, protocol::GatewayRefusal::gateway_failure);
     } else {
         respond(slot.transaction_id, slot.unit, response_pdu);
     }
@@ -220,11 +234,8 @@ void Connection::complete(std::uint16_t index, std::uint32_t generation, protoco
 }
 
 void Connection::respond_exception(std::uint16_t transaction_id, std::uint8_t unit, std::uint8_t function,
-                                   std::uint8_t code) {
-    // Built by hand rather than with encode_exception(): a request may carry a
-    // function code >= 0x80 and still gets an answer.
-    const std::uint8_t pdu[2] = {static_cast<std::uint8_t>(function | protocol::fc::exception_flag), code};
-    respond(transaction_id, unit, protocol::ByteView(pdu, 2));
+                                   protocol::GatewayRefusal refusal) {
+    respond(transaction_id, unit, protocol::exception_pdu(function, refusal));
 }
 
 void Connection::respond(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {

@@ -24,6 +24,7 @@
 #include "northbound/modbus_tcp/connection_context.hpp"
 #include "northbound/unit_target.hpp"
 #include "protocol/bytes.hpp"
+#include "protocol/gateway_exceptions.hpp"
 
 namespace fieldbridge::northbound::modbus_tcp {
 
@@ -79,7 +80,7 @@ private:
     void complete(std::uint16_t slot, std::uint32_t generation, protocol::Bytes response_pdu);
     void respond(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu);
     void respond_exception(std::uint16_t transaction_id, std::uint8_t unit, std::uint8_t function,
-                           std::uint8_t code);
+                           protocol::GatewayRefusal refusal);
     void write();
     void on_write(const asio::error_code& error);
     /// Resumes reading after a slot freed (posted: never inside a target's call).

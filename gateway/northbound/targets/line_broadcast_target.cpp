@@ -2,11 +2,16 @@
 
 #include <asio/post.hpp>
 
+#include "engine/device_agent_answers.hpp"
+#include "engine/line_timing.hpp"
+#include "protocol/gateway_exceptions.hpp"
 #include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::northbound {
 
 namespace {
+
+using protocol::GatewayRefusal;
 
 /// What a device would have answered to the write (Modbus 6.5, 6.6, 6.11, 6.12).
 std::optional<protocol::Response> write_echo(const protocol::Request& request) {
@@ -29,39 +34,127 @@ std::optional<protocol::Response> write_echo(const protocol::Request& request) {
     return std::nullopt;
 }
 
+/// RTU framing around a PDU: address byte and CRC (Modbus over Serial Line 2.5.1).
+constexpr std::size_t rtu_overhead = 3;
+
 }  // namespace
 
-LineBroadcastTarget::LineBroadcastTarget(asio::io_context& io, engine::LineWorker& line,
-                                         std::vector<std::uint8_t> addresses, engine::Duration command_ttl)
-    : io_(io), line_(line), addresses_(std::move(addresses)), command_ttl_(command_ttl) {}
+/// What the transactions' callbacks share with the target: they may complete after
+/// it is gone (then `line` is null and nothing more is submitted).
+struct LineBroadcastTarget::Shared {
+    asio::io_context& io;
+    engine::LineWorker* line;
+    engine::Duration command_ttl;
+};
+
+/// One broadcast on its way: its steps, the next one, and who to answer.
+struct LineBroadcastTarget::Operation {
+    std::vector<BroadcastStep> steps;
+    std::size_t next = 0;
+    std::uint8_t function = 0;
+    protocol::Bytes echo;
+    PduHandler done;
+
+    void answer(asio::io_context& io, protocol::Bytes pdu) {
+        if (!done) return;
+        // Never from inside handle() or the line's completion (unit_target.hpp).
+        asio::post(io, [done = std::move(done), pdu = std::move(pdu)]() mutable { done(std::move(pdu)); });
+        done = nullptr;
+    }
+};
+
+LineBroadcastTarget::LineBroadcastTarget(asio::io_context& io, engine::LineWorker& line, std::vector<LineUnit> devices,
+                                         BroadcastSettings settings)
+    : shared_(std::make_shared<Shared>(Shared{io, &line, settings.command_ttl})),
+      devices_(std::move(devices)),
+
+      budget_(settings.share_percent) {
+    for (const LineUnit& device : devices_) units_.push_back(device.unit_id);
+}
+
+LineBroadcastTarget::~LineBroadcastTarget() { shared_->line = nullptr; }
+
+engine::Duration LineBroadcastTarget::line_time(const std::vector<BroadcastStep>& steps) const {
+    const engine::LineTimingConfig& timing = shared_->line->config().timing;
+    const engine::LineTiming wire(timing.format(), timing.inter_frame);
+    engine::Duration total{};
+    for (const BroadcastStep& step : steps) {
+        const std::size_t frame =
+            protocol::encode_request(std::get<engine::ModbusPayload>(step.payload).request).size() + rtu_overhead;
+        total += step.delay_before + wire.transaction_time(frame, 0, timing.broadcast_delay);
+    }
+    return total;
+}
 
 void LineBroadcastTarget::handle(std::uint8_t /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
                                  PduHandler done) {
-    protocol::Bytes answer;
+    asio::io_context& io = shared_->io;
+    auto op = std::make_shared<Operation>();
+    op->function = request_pdu.empty() ? 0 : request_pdu[0];
+    op->done = std::move(done);
+    const auto refuse = [&](protocol::Bytes pdu) { op->answer(io, std::move(pdu)); };
     const auto decoded = protocol::decode_request(request_pdu);
-    const std::uint8_t function = request_pdu.empty() ? 0 : request_pdu[0];
-    const std::uint8_t usable = (function == 0 || function >= 0x80) ? std::uint8_t{0x7F} : function;
     if (!decoded.complete()) {
-        answer = protocol::encode_exception(usable, protocol::ExceptionCode::illegal_data_value);
-    } else if (const auto echo = write_echo(decoded.value); !echo) {
-        answer = protocol::encode_exception(usable, protocol::ExceptionCode::illegal_function);
-    } else if (!line_.line_up()) {
-        answer = protocol::encode_exception(usable, protocol::ExceptionCode::gateway_path_unavailable);
-    } else {
-        const auto now = engine::Clock::now();
-        for (const std::uint8_t address : addresses_) {
-            engine::Transaction transaction;
-            transaction.device = engine::broadcast_device;
-            transaction.address = address;
-            transaction.payload = engine::ModbusPayload{decoded.value};
-            transaction.priority = engine::Priority::command;
-            transaction.deadline = now + command_ttl_;
-            transaction.on_done = [](const engine::Outcome&) {};
-            line_.submit(std::move(transaction));
-        }
-        answer = protocol::encode_response(*echo);
+        refuse(protocol::exception_pdu(op->function, protocol::is_function_code(op->function)
+                                                         ? GatewayRefusal::bad_value
+                                                         : GatewayRefusal::not_a_function));
+        return;
     }
-    asio::post(io_, [done = std::move(done), answer = std::move(answer)]() mutable { done(std::move(answer)); });
+    const auto echo = write_echo(decoded.value);
+    if (!echo) {
+        refuse(protocol::exception_pdu(op->function, GatewayRefusal::unsupported));
+        return;
+    }
+    if (!shared_->line->line_up()) {
+        refuse(protocol::exception_pdu(op->function, GatewayRefusal::path_down));
+        return;
+    }
+    std::vector<BroadcastMember> members;
+    members.reserve(devices_.size());
+    for (const LineUnit& device : devices_) {
+        members.push_back(BroadcastMember{&device.agent->profile(), &device.agent->image(),
+                                          device.agent->config().delay_before_command});
+    }
+    BroadcastPlan plan = plan_broadcast(decoded.value, members);
+    if (plan.refusal) {
+        refuse(protocol::exception_pdu(op->function, *plan.refusal));
+        return;
+    }
+    if (!budget_.take(line_time(plan.steps), engine::Clock::now())) {
+        refuse(protocol::exception_pdu(op->function, GatewayRefusal::busy));
+        return;
+    }
+    op->steps = std::move(plan.steps);
+    op->echo = protocol::encode_response(*echo);
+    submit_step(shared_, op);
+}
+
+void LineBroadcastTarget::submit_step(const std::shared_ptr<Shared>& shared, const std::shared_ptr<Operation>& op) {
+    if (shared->line == nullptr) {
+        op->answer(shared->io, protocol::exception_pdu(op->function, GatewayRefusal::path_down));
+        return;
+    }
+    const BroadcastStep& step = op->steps[op->next];
+    engine::Transaction transaction;
+    transaction.device = engine::broadcast_device;
+    transaction.address = step.address;
+    transaction.payload = step.payload;
+    transaction.priority = engine::Priority::command;
+    transaction.urgent = step.urgent;          // rule 4
+    transaction.delay_before = step.delay_before;  // rule 11
+    transaction.deadline = engine::Clock::now() + shared->command_ttl;  // rule 9
+    transaction.on_done = [shared, op](const engine::Outcome& outcome) {
+        if (outcome.status != engine::OutcomeStatus::broadcast_sent) {
+            op->answer(shared->io, protocol::exception_pdu(op->function, engine::refusal_for(outcome.status)));
+            return;
+        }
+        if (++op->next == op->steps.size()) {
+            op->answer(shared->io, std::move(op->echo));
+            return;
+        }
+        submit_step(shared, op);
+    };
+    shared->line->submit(std::move(transaction));
 }
 
 }  // namespace fieldbridge::northbound

@@ -2,21 +2,10 @@
 
 #include <asio/post.hpp>
 
+#include "protocol/gateway_exceptions.hpp"
 #include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::northbound {
-
-namespace {
-
-protocol::Bytes exception_pdu(protocol::ByteView request_pdu, protocol::ExceptionCode code) {
-    const std::uint8_t function = request_pdu.empty() ? 0 : request_pdu[0];
-    // encode_exception needs 1..127: a PDU without a usable function code is answered
-    // as 0xFF (0x7F | 0x80), the highest code, rather than not at all.
-    const std::uint8_t usable = (function == 0 || function >= 0x80) ? std::uint8_t{0x7F} : function;
-    return protocol::encode_exception(usable, code);
-}
-
-}  // namespace
 
 SerialDeviceTarget::SerialDeviceTarget(asio::io_context& io, engine::DeviceAgent& agent,
                                        const engine::LineWorker& line)
@@ -30,16 +19,17 @@ void SerialDeviceTarget::answer(PduHandler done, protocol::Bytes pdu) {
 void SerialDeviceTarget::handle(std::uint8_t /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
                                 PduHandler done) {
     const auto decoded = protocol::decode_request(request_pdu);
+    const std::uint8_t function = request_pdu.empty() ? 0 : request_pdu[0];
     if (!decoded.complete()) {
-        // A function code 0 / >= 0x80 is no function at all; anything else that does
+        // A function byte 0 / >= 0x80 is no function at all; anything else that does
         // not decode has a bad quantity, byte count or length (Modbus 6.x: 0x03).
-        const bool bad_function = request_pdu.empty() || request_pdu[0] == 0 || request_pdu[0] >= 0x80;
-        answer(std::move(done), exception_pdu(request_pdu, bad_function ? protocol::ExceptionCode::illegal_function
-                                                                         : protocol::ExceptionCode::illegal_data_value));
+        answer(std::move(done), protocol::exception_pdu(function, protocol::is_function_code(function)
+                                                                      ? protocol::GatewayRefusal::bad_value
+                                                                      : protocol::GatewayRefusal::not_a_function));
         return;
     }
     if (!line_.line_up()) {
-        answer(std::move(done), exception_pdu(request_pdu, protocol::ExceptionCode::gateway_path_unavailable));
+        answer(std::move(done), protocol::exception_pdu(function, protocol::GatewayRefusal::path_down));
         return;
     }
     agent_.request(decoded.value, [done = std::move(done)](const protocol::Response& response) {

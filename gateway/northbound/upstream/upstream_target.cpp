@@ -9,32 +9,30 @@
 #include "northbound/upstream/r6_state.hpp"
 #include "northbound/upstream/request_class.hpp"
 #include "northbound/upstream/upstream_scheduler.hpp"
+#include "protocol/gateway_exceptions.hpp"
 #include "protocol/mbap_frame.hpp"
 
 namespace fieldbridge::northbound::upstream {
 namespace {
 
 using engine::Clock;
-using protocol::ExceptionCode;
 
-protocol::Bytes exception_pdu(std::uint8_t function, ExceptionCode code) {
-    // Built by hand: the function byte of a PDU refused for its function code may be
-    // 0 or already have the exception flag.
-    return {static_cast<std::uint8_t>(function | protocol::fc::exception_flag), static_cast<std::uint8_t>(code)};
-}
+using protocol::exception_pdu;
+using protocol::GatewayRefusal;
 
-/// spec §4: 0x0A the path is unavailable (nothing was sent), 0x0B the target did not
-/// answer in time (or the command's deadline passed), 0x06 the queue is full.
+/// spec §4 through the gateway's one mapping (protocol/gateway_exceptions.hpp):
+/// 0x0A the path is unavailable (nothing was sent), 0x0B the target did not answer in
+/// time (or the command's deadline passed), 0x06 the queue is full.
 protocol::Bytes answer_pdu(std::uint8_t function, const UpstreamOutcome& outcome) {
     switch (outcome.status) {
         case UpstreamStatus::ok: return outcome.response_pdu;
-        case UpstreamStatus::timeout:
-        case UpstreamStatus::expired: return exception_pdu(function, ExceptionCode::gateway_target_failed);
-        case UpstreamStatus::queue_full: return exception_pdu(function, ExceptionCode::server_device_busy);
+        case UpstreamStatus::timeout: return exception_pdu(function, GatewayRefusal::no_answer);
+        case UpstreamStatus::expired: return exception_pdu(function, GatewayRefusal::expired);
+        case UpstreamStatus::queue_full: return exception_pdu(function, GatewayRefusal::busy);
         case UpstreamStatus::path_down:
         case UpstreamStatus::cancelled: break;
     }
-    return exception_pdu(function, ExceptionCode::gateway_path_unavailable);
+    return exception_pdu(function, GatewayRefusal::path_down);
 }
 
 SchedulerSettings scheduler_settings(const config::UpstreamConfig& c, const UpstreamTuning& t) {
@@ -109,7 +107,7 @@ public:
         const std::uint8_t function = pdu.empty() ? 0 : pdu[0];
         const Unit* unit = find(unit_id);
         if (unit == nullptr || !started_) {
-            answer_later(std::move(done), exception_pdu(function, ExceptionCode::gateway_path_unavailable));
+            answer_later(std::move(done), exception_pdu(function, GatewayRefusal::path_down));
             return;
         }
         const Classified classified = classify(pdu);
@@ -120,7 +118,7 @@ public:
         const LinkState link = link_->state();
         if (link != LinkState::up && link != LinkState::connecting) {
             ++stats_.path_down;
-            answer_later(std::move(done), exception_pdu(function, ExceptionCode::gateway_path_unavailable));
+            answer_later(std::move(done), exception_pdu(function, GatewayRefusal::path_down));
             return;
         }
         UpstreamRequest request;

@@ -66,6 +66,7 @@ TEST_CASE("the example configuration loads and uses every section") {
     CHECK(line.devices[3].blocks.size() == 3);
     CHECK(line.devices[3].word_order == WordOrder::low_first);
     CHECK(line.broadcast_unit == std::uint8_t{100});
+    CHECK(line.broadcast_share == 10U);
     CHECK(config->lines[1].devices.at(0).type == DeviceType::wtec_rtu);
     REQUIRE(config->upstreams.size() == 1);
     CHECK(config->upstreams[0].units.at(0).unit_id == 50);
@@ -167,6 +168,7 @@ upstreams:
     CHECK(line.offline_after == 3);
     CHECK(line.offline_backoff == Backoff{1s, 30s});
     CHECK_FALSE(line.broadcast_unit.has_value());
+    CHECK(line.broadcast_share == 10U);
 
     const auto& device = line.devices.at(0);
     CHECK(device.max_age == 200ms);

@@ -239,6 +239,7 @@ lines:
     port: /dev/ttyS1
     offline_backoff: {max: 500ms}
     broadcast_unit: 0
+    broadcast_share: 0
 )";
     CHECK_REPORTS(ranges, "lines[0].response_timeout", 5, 23, "expected 1ms..10s");
     CHECK_REPORTS(ranges, "lines[0].byte_timeout", 6, 19, "expected 1ms..1s");
@@ -248,7 +249,8 @@ lines:
     CHECK_REPORTS(ranges, "lines[0].offline_backoff.max", 10, 42, "max (5s) is shorter than initial (10s)");
     CHECK_REPORTS(ranges, "lines[1].offline_backoff.max", 13, 28, "initial (1s, the default)");
     CHECK_REPORTS(ranges, "lines[1].broadcast_unit", 14, 21, "expected 1..247");
-    CHECK(diagnostics_of(ranges).size() == 8);
+    CHECK_REPORTS(ranges, "lines[1].broadcast_share", 15, 22, "expected 1..100");
+    CHECK(diagnostics_of(ranges).size() == 9);
 }
 
 TEST_CASE("unique unit IDs, names, ports, addresses and servers") {

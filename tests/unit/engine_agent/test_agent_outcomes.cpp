@@ -21,11 +21,13 @@ TEST_CASE("agent outcomes: each failure maps to its exception, under the client'
     const Case cases[] = {
         {OutcomeStatus::timeout, ExceptionCode::gateway_target_failed},
         {OutcomeStatus::device_offline, ExceptionCode::gateway_target_failed},
-        {OutcomeStatus::line_down, ExceptionCode::gateway_target_failed},
+        // Spec §4: "0x0A when ... its line is down"; nothing was sent.
+        {OutcomeStatus::line_down, ExceptionCode::gateway_path_unavailable},
         // Spec §4 / rule 9: "0x0B when ... a command's deadline passed".
         {OutcomeStatus::expired, ExceptionCode::gateway_target_failed},
         {OutcomeStatus::queue_full, ExceptionCode::server_device_busy},
-        {OutcomeStatus::cancelled, ExceptionCode::server_device_failure},
+        // Shut down or reconfigured before it was sent: the path went away.
+        {OutcomeStatus::cancelled, ExceptionCode::gateway_path_unavailable},
         {OutcomeStatus::invalid_request, ExceptionCode::server_device_failure},
     };
     for (const Case& c : cases) {

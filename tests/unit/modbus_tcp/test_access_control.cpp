@@ -1,4 +1,5 @@
 // Request scope and rule decisions (pure), and the unit routing table.
+#include <vector>
 #include <doctest/doctest.h>
 
 #include "fake_targets.hpp"
@@ -30,13 +31,28 @@ TEST_CASE("request_scope reads the address fields of FC01-06, 0F, 10 and both ra
           RequestScope{0x17, RegisterRange{3, 8}, RegisterRange{0x0E, 0x10}});
 }
 
-TEST_CASE("request_scope: no range without address fields, and a malformed quantity never shrinks the range") {
-    CHECK(request_scope(Bytes{0x07}) == RequestScope{0x07, {}, {}});
-    CHECK(request_scope(Bytes{0x2B, 0x0E, 0x01, 0x00}) == RequestScope{0x2B, {}, {}});
-    CHECK(request_scope(Bytes{0x03, 0x00, 0x10, 0x00}) == RequestScope{0x03, {}, {}});  // truncated
-    CHECK(request_scope(Bytes{0x06, 0x00}) == RequestScope{0x06, {}, {}});
-    CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00}) == RequestScope{0x17, {}, {}});
-    CHECK(request_scope(Bytes{}) == RequestScope{});
+TEST_CASE("request_scope fails closed: what it cannot derive touches every register") {
+    const RegisterRange all{0x0000, 0xFFFF};
+    // Only the function codes that read no register and change nothing have no range.
+    for (const std::uint8_t function : std::vector<std::uint8_t>{0x07, 0x0B, 0x0C, 0x11}) {
+        CHECK(request_scope(Bytes{function}) == RequestScope{function, {}, {}});
+    }
+    // FC22 (0x16, mask write) is derived: its one register.
+    CHECK(request_scope(Bytes{0x16, 0x4E, 0x20, 0xFF, 0xFF, 0x00, 0x01}) ==
+          RequestScope{0x16, RegisterRange{0x4E20, 0x4E20}, {}});
+    // Diagnostics, file records, FIFO, encapsulated transport, vendor codes, 0 and >= 0x80.
+    for (const std::uint8_t function : std::vector<std::uint8_t>{0x08, 0x14, 0x15, 0x18, 0x2B, 0x41, 0x64, 0x00, 0x85, 0xFF}) {
+        CHECK(request_scope(Bytes{function, 0x0E, 0x01, 0x00}) == RequestScope{function, all, {}});
+    }
+    // Too short to carry the address fields.
+    CHECK(request_scope(Bytes{0x03, 0x00, 0x10, 0x00}) == RequestScope{0x03, all, {}});
+    CHECK(request_scope(Bytes{0x06, 0x00}) == RequestScope{0x06, all, {}});
+    CHECK(request_scope(Bytes{0x16, 0x4E}) == RequestScope{0x16, all, {}});
+    CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00}) == RequestScope{0x17, all, {}});
+    CHECK(request_scope(Bytes{}) == RequestScope{0x00, all, {}});
+}
+
+TEST_CASE("request_scope: a malformed quantity never shrinks the range") {
     // Quantity 0 still names the addressed register.
     CHECK(request_scope(Bytes{0x03, 0x00, 0x64, 0x00, 0x00}) == RequestScope{0x03, RegisterRange{100, 100}, {}});
     // Past 0xFFFF: ends at 0xFFFF.
@@ -72,7 +88,7 @@ TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges 
     const Bytes rw_read_outside{0x17, 0x00, 0x00, 0x00, 0x01, 0x01, 0x10, 0x00, 0x01, 0x02, 0x00, 0x01};
     CHECK(request_allowed(config, plc, 1, request_scope(rw_inside)));
     CHECK_FALSE(request_allowed(config, plc, 1, request_scope(rw_read_outside)));
-    // A truncated write has no range: the allow rule (with a range) cannot match it.
+    // A truncated write may touch anything: the allow rule (with a range) cannot match it.
     CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x01})));
 }
 
@@ -86,6 +102,11 @@ TEST_CASE("a deny rule matches any overlap with its register range") {
     CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x20})));
     CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x10})));  // ends at 0x1FF
     CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x07})));  // no registers: no match
+    // Fail closed: FC22 in the range, and what the server cannot derive, are denied.
+    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x16, 0x02, 0x01, 0xFF, 0xFF, 0, 1})));
+    CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x16, 0x02, 0x04, 0xFF, 0xFF, 0, 1})));
+    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x15, 0x07, 0x06, 0, 1, 0, 0, 0, 1})));
+    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x41, 0x00})));
 }
 
 TEST_CASE("UnitRouter: set, replace, remove, distinct targets") {

@@ -1,0 +1,40 @@
+#include "northbound/targets/broadcast_budget.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace fieldbridge::northbound {
+namespace {
+
+constexpr engine::Duration window = std::chrono::seconds{1};
+
+[[nodiscard]] engine::Duration share_of(engine::Duration d, unsigned percent) noexcept {
+    return d * percent / 100;
+}
+
+}  // namespace
+
+BroadcastBudget::BroadcastBudget(unsigned share_percent) noexcept
+    : share_percent_(std::clamp(share_percent, 1U, 100U)),
+      capacity_(share_of(window, share_percent_)),
+      balance_(capacity_) {}
+
+void BroadcastBudget::refill(engine::TimePoint now) noexcept {
+    if (!started_) {
+        started_ = true;
+        last_ = now;
+        return;
+    }
+    if (now <= last_) return;
+    balance_ = std::min(capacity_, balance_ + share_of(now - last_, share_percent_));
+    last_ = now;
+}
+
+bool BroadcastBudget::take(engine::Duration cost, engine::TimePoint now) noexcept {
+    refill(now);
+    if (balance_ <= engine::Duration::zero()) return false;
+    balance_ -= cost;
+    return true;
+}
+
+}  // namespace fieldbridge::northbound

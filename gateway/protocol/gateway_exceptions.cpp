@@ -1,0 +1,30 @@
+#include "protocol/gateway_exceptions.hpp"
+
+namespace fieldbridge::protocol {
+
+ExceptionCode exception_code(GatewayRefusal refusal) noexcept {
+    // Modbus Application Protocol V1.1b3 section 7 for the meaning of each code.
+    switch (refusal) {
+        case GatewayRefusal::not_a_function:
+        case GatewayRefusal::unsupported:
+        case GatewayRefusal::denied: return ExceptionCode::illegal_function;
+        case GatewayRefusal::bad_address: return ExceptionCode::illegal_data_address;
+        case GatewayRefusal::bad_value: return ExceptionCode::illegal_data_value;
+        case GatewayRefusal::path_down: return ExceptionCode::gateway_path_unavailable;
+        case GatewayRefusal::busy: return ExceptionCode::server_device_busy;
+        case GatewayRefusal::no_answer:
+        case GatewayRefusal::expired: return ExceptionCode::gateway_target_failed;
+        case GatewayRefusal::gateway_failure: break;
+    }
+    return ExceptionCode::server_device_failure;
+}
+
+Bytes exception_pdu(std::uint8_t function, ExceptionCode code) {
+    return {static_cast<std::uint8_t>(function | fc::exception_flag), static_cast<std::uint8_t>(code)};
+}
+
+Bytes exception_pdu(std::uint8_t function, GatewayRefusal refusal) {
+    return exception_pdu(function, exception_code(refusal));
+}
+
+}  // namespace fieldbridge::protocol

@@ -1,0 +1,45 @@
+#pragma once
+/// @file gateway_exceptions.hpp
+/// The one place where the gateway decides which Modbus exception a northbound
+/// client gets when the answer does not come from a device (spec §4, §8;
+/// docs/modbus-tcp.md, "Exception responses"), and the one encoder of exception
+/// PDUs for every target (serial device, broadcast unit, upstream unit) and for the
+/// server itself. Pure.
+#include <cstdint>
+
+#include "protocol/bytes.hpp"
+#include "protocol/modbus_pdu.hpp"
+
+namespace fieldbridge::protocol {
+
+/// Why a request is answered by the gateway instead of by its device.
+enum class GatewayRefusal : std::uint8_t {
+    not_a_function,   ///< function byte 0 or >= 0x80: no Modbus function code at all
+    unsupported,      ///< a function code the target does not carry
+    denied,           ///< an access rule or a protected register without allow_protected
+    bad_address,      ///< outside the map, across a hole, half of a 32-bit pair
+    bad_value,        ///< quantity, byte count, length or value out of range
+    path_down,        ///< no route, line or link down, or shut down / reconfigured before it was sent
+    busy,             ///< a queue is full, or the line's broadcast budget is spent
+    no_answer,        ///< the device did not answer (timeout, offline)
+    expired,          ///< its deadline passed before it could start: never sent
+    gateway_failure,  ///< the gateway could not carry it (internal error)
+};
+
+/// 0x01 not_a_function / unsupported / denied, 0x02 bad_address, 0x03 bad_value,
+/// 0x0A path_down, 0x06 busy, 0x0B no_answer / expired, 0x04 gateway_failure.
+[[nodiscard]] ExceptionCode exception_code(GatewayRefusal refusal) noexcept;
+
+/// True for the function codes Modbus defines room for: 1..127.
+[[nodiscard]] constexpr bool is_function_code(std::uint8_t function) noexcept {
+    return function != 0 && function < fc::exception_flag;
+}
+
+/// The exception PDU to a request whose first byte is @p function (0 for an empty
+/// PDU): that byte with bit 7 set, then the code. The same rule for every byte, so
+/// a request with function byte 0 gets 0x80 and one with 0x80..0xFF gets its own
+/// byte back (encode_exception() takes real function codes only).
+[[nodiscard]] Bytes exception_pdu(std::uint8_t function, ExceptionCode code);
+[[nodiscard]] Bytes exception_pdu(std::uint8_t function, GatewayRefusal refusal);
+
+}  // namespace fieldbridge::protocol
