@@ -44,6 +44,8 @@ void set(T& target, const Field<T>& field) {
     }
     tcp.max_connections = narrow<std::size_t>(raw.max_connections, tcp.max_connections);
     set(tcp.idle_timeout, raw.idle_timeout);
+    set(tcp.frame_timeout, raw.frame_timeout);
+    tcp.max_connections_per_client = narrow<std::size_t>(raw.max_connections_per_client, tcp.max_connections_per_client);
     for (const auto& item : raw.allow.items) {
         tcp.allow.push_back(*item);
     }

@@ -119,6 +119,12 @@ struct ModbusTcpConfig {
     static constexpr Range<std::int64_t> max_connections_range{1, 1024};
     milliseconds idle_timeout = seconds{60};  ///< 0: idle connections are never closed
     static constexpr Range<milliseconds> idle_timeout_range{milliseconds{0}, std::chrono::hours{24}};
+    /// A frame must be complete this long after its first byte arrived (slowloris).
+    milliseconds frame_timeout = seconds{5};
+    static constexpr Range<milliseconds> frame_timeout_range{milliseconds{10}, seconds{60}};
+    /// Open connections from one client address; further ones are refused.
+    std::size_t max_connections_per_client = 16;
+    static constexpr Range<std::int64_t> max_connections_per_client_range{1, 1024};
     std::vector<Cidr> allow;  ///< empty: any client
     std::vector<AccessRule> rules;
 

@@ -88,6 +88,8 @@ struct RawModbusTcp : RawNode {
     FieldList<ListenAddress> listen;
     Field<std::int64_t> max_connections;
     Field<std::chrono::milliseconds> idle_timeout;
+    Field<std::chrono::milliseconds> frame_timeout;
+    Field<std::int64_t> max_connections_per_client;
     FieldList<Cidr> allow;
     RawSeq<RawRule> rules;
 };

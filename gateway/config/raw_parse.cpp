@@ -45,12 +45,17 @@ RawRule parse_rule(const NodeRef& ref, DiagnosticSink& sink) {
 }
 
 RawModbusTcp parse_modbus_tcp(const NodeRef& ref, DiagnosticSink& sink) {
-    const MapReader map(ref, {"listen", "max_connections", "idle_timeout", "allow", "rules"}, sink);
+    const MapReader map(ref,
+                        {"listen", "max_connections", "idle_timeout", "frame_timeout", "max_connections_per_client",
+                         "allow", "rules"},
+                        sink);
     RawModbusTcp raw;
     map.fill(raw);
     raw.listen = read_list<ListenAddress>(map, "listen", "addresses such as 0.0.0.0:502", parse_listen_address);
     raw.max_connections = read_int(map, "max_connections");
     raw.idle_timeout = read_duration(map, "idle_timeout");
+    raw.frame_timeout = read_duration(map, "frame_timeout");
+    raw.max_connections_per_client = read_int(map, "max_connections_per_client");
     raw.allow = read_cidr_list(map, "allow");
     raw.rules = read_seq<RawRule>(map, "rules", parse_rule);
     return raw;

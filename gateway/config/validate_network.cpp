@@ -63,6 +63,8 @@ void check_modbus_tcp(const RawModbusTcp& tcp, DiagnosticSink& sink) {
     }
     check_range(sink, tcp.max_connections, ModbusTcpConfig::max_connections_range);
     check_range(sink, tcp.idle_timeout, ModbusTcpConfig::idle_timeout_range);
+    check_range(sink, tcp.frame_timeout, ModbusTcpConfig::frame_timeout_range);
+    check_range(sink, tcp.max_connections_per_client, ModbusTcpConfig::max_connections_per_client_range);
     for (const auto& rule : tcp.rules.items) {
         if (rule.ok()) {
             check_rule(rule, sink);

@@ -55,6 +55,22 @@ modbus_tcp:
                   "needs brackets");
 }
 
+TEST_CASE("modbus_tcp: frame deadline and per-client connection cap") {
+    const char* yaml = R"(
+gateway: {id: t}
+modbus_tcp:
+  frame_timeout: 5ms
+  max_connections_per_client: 0
+)";
+    CHECK_REPORTS(yaml, "modbus_tcp.frame_timeout", 3, 18, "expected 10ms..1min");
+    CHECK_REPORTS(yaml, "modbus_tcp.max_connections_per_client", 4, 31, "expected 1..1024");
+    CHECK(diagnostics_of(yaml).size() == 2);
+    CHECK_REPORTS("gateway: {id: t}\nmodbus_tcp: {frame_timeout: 2min}\n", "modbus_tcp.frame_timeout", 2, 29,
+                  "expected 10ms..1min");
+    CHECK(diagnostics_of("gateway: {id: t}\nmodbus_tcp: {frame_timeout: 60s, max_connections_per_client: 1024}\n")
+              .empty());
+}
+
 TEST_CASE("upstreams") {
     const char* yaml = R"(
 gateway: {id: t}
