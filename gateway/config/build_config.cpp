@@ -136,6 +136,7 @@ void set(T& target, const Field<T>& field) {
     set(upstream.response_timeout, raw.response_timeout);
     upstream.reconnect_backoff = build_backoff(raw.reconnect_backoff, upstream.reconnect_backoff);
     set(upstream.poll_period, raw.poll_period);
+    set(upstream.sequence_max_hold, raw.sequence_max_hold);
     set(upstream.command_ttl, raw.command_ttl);
     upstream.queue_limit = narrow<std::size_t>(raw.queue_limit, upstream.queue_limit);
     for (const auto& raw_unit : raw.units.items) {
@@ -196,6 +197,11 @@ void set(T& target, const Field<T>& field) {
     }
     set(mqtt.diag_period, raw.diag_period);
     mqtt.reconnect_backoff = build_backoff(raw.reconnect_backoff, mqtt.reconnect_backoff);
+    mqtt.max_command_bytes = narrow<std::size_t>(raw.max_command_bytes, mqtt.max_command_bytes);
+    mqtt.max_command_id_length = narrow<std::size_t>(raw.max_command_id_length, mqtt.max_command_id_length);
+    mqtt.max_queued_commands = narrow<std::size_t>(raw.max_queued_commands, mqtt.max_queued_commands);
+    mqtt.max_queued_command_bytes = narrow<std::size_t>(raw.max_queued_command_bytes, mqtt.max_queued_command_bytes);
+    mqtt.outbox_max_bytes = narrow<std::size_t>(raw.outbox_max_bytes, mqtt.outbox_max_bytes);
     return mqtt;
 }
 

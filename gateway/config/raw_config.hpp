@@ -167,6 +167,7 @@ struct RawUpstream : RawNode {
     Field<std::chrono::milliseconds> response_timeout;
     RawBackoff reconnect_backoff;
     Field<std::chrono::milliseconds> poll_period;
+    Field<std::chrono::milliseconds> sequence_max_hold;
     Field<std::chrono::milliseconds> command_ttl;
     Field<std::int64_t> queue_limit;
     RawSeq<RawUpstreamUnit> units;
@@ -201,6 +202,11 @@ struct RawMqtt : RawNode {
     RawDeadband deadband;
     Field<std::chrono::milliseconds> diag_period;
     RawBackoff reconnect_backoff;
+    Field<std::int64_t> max_command_bytes;
+    Field<std::int64_t> max_command_id_length;
+    Field<std::int64_t> max_queued_commands;
+    Field<std::int64_t> max_queued_command_bytes;
+    Field<std::int64_t> outbox_max_bytes;
 };
 
 struct RawMetricsHttp : RawNode {

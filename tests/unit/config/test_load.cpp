@@ -147,6 +147,11 @@ upstreams:
     CHECK(tcp.max_connections == 64);
     CHECK(tcp.idle_timeout == 60s);
     CHECK(tcp.frame_timeout == 5s);
+    CHECK(config->mqtt.max_command_bytes == 16384);
+    CHECK(config->mqtt.max_command_id_length == 128);
+    CHECK(config->mqtt.max_queued_commands == 64);
+    CHECK(config->mqtt.max_queued_command_bytes == 1024 * 1024);
+    CHECK(config->mqtt.outbox_max_bytes == 4 * 1024 * 1024);
     CHECK(tcp.max_connections_per_client == 16);
     CHECK(tcp.allow.empty());
     CHECK(tcp.rules.empty());
