@@ -44,6 +44,8 @@ void set(T& target, const Field<T>& field) {
     }
     tcp.max_connections = narrow<std::size_t>(raw.max_connections, tcp.max_connections);
     set(tcp.idle_timeout, raw.idle_timeout);
+    set(tcp.frame_timeout, raw.frame_timeout);
+    tcp.max_connections_per_client = narrow<std::size_t>(raw.max_connections_per_client, tcp.max_connections_per_client);
     for (const auto& item : raw.allow.items) {
         tcp.allow.push_back(*item);
     }
@@ -135,6 +137,7 @@ void set(T& target, const Field<T>& field) {
     set(upstream.response_timeout, raw.response_timeout);
     upstream.reconnect_backoff = build_backoff(raw.reconnect_backoff, upstream.reconnect_backoff);
     set(upstream.poll_period, raw.poll_period);
+    set(upstream.sequence_max_hold, raw.sequence_max_hold);
     set(upstream.command_ttl, raw.command_ttl);
     upstream.queue_limit = narrow<std::size_t>(raw.queue_limit, upstream.queue_limit);
     for (const auto& raw_unit : raw.units.items) {
@@ -195,6 +198,11 @@ void set(T& target, const Field<T>& field) {
     }
     set(mqtt.diag_period, raw.diag_period);
     mqtt.reconnect_backoff = build_backoff(raw.reconnect_backoff, mqtt.reconnect_backoff);
+    mqtt.max_command_bytes = narrow<std::size_t>(raw.max_command_bytes, mqtt.max_command_bytes);
+    mqtt.max_command_id_length = narrow<std::size_t>(raw.max_command_id_length, mqtt.max_command_id_length);
+    mqtt.max_queued_commands = narrow<std::size_t>(raw.max_queued_commands, mqtt.max_queued_commands);
+    mqtt.max_queued_command_bytes = narrow<std::size_t>(raw.max_queued_command_bytes, mqtt.max_queued_command_bytes);
+    mqtt.outbox_max_bytes = narrow<std::size_t>(raw.outbox_max_bytes, mqtt.outbox_max_bytes);
     return mqtt;
 }
 

@@ -119,6 +119,12 @@ struct ModbusTcpConfig {
     static constexpr Range<std::int64_t> max_connections_range{1, 1024};
     milliseconds idle_timeout = seconds{60};  ///< 0: idle connections are never closed
     static constexpr Range<milliseconds> idle_timeout_range{milliseconds{0}, std::chrono::hours{24}};
+    /// A frame must be complete this long after its first byte arrived (slowloris).
+    milliseconds frame_timeout = seconds{5};
+    static constexpr Range<milliseconds> frame_timeout_range{milliseconds{10}, seconds{60}};
+    /// Open connections from one client address; further ones are refused.
+    std::size_t max_connections_per_client = 16;
+    static constexpr Range<std::int64_t> max_connections_per_client_range{1, 1024};
     std::vector<Cidr> allow;  ///< empty: any client
     std::vector<AccessRule> rules;
 
@@ -260,6 +266,10 @@ struct UpstreamConfig {
     static constexpr Range<milliseconds> command_ttl_range{milliseconds{1}, std::chrono::minutes{1}};
     std::size_t queue_limit = 32;
     static constexpr Range<std::int64_t> queue_limit_range{1, 1024};
+    /// A stateful sequence (counter select, data-source set-up) holds its registers
+    /// against other clients at most this long after it began, whatever its owner does.
+    milliseconds sequence_max_hold{500};
+    static constexpr Range<milliseconds> sequence_max_hold_range{milliseconds{10}, seconds{10}};
     std::vector<UpstreamUnitConfig> units;  ///< at least one
     bool operator==(const UpstreamConfig&) const = default;
 };
@@ -296,6 +306,20 @@ struct MqttConfig {
     milliseconds diag_period = seconds{10};
     static constexpr Range<milliseconds> diag_period_range{seconds{1}, std::chrono::hours{1}};
     Backoff reconnect_backoff{seconds{1}, seconds{60}};
+    /// A larger command payload gets an error result (`too_large`) and is not parsed.
+    std::size_t max_command_bytes = 16 * 1024;
+    static constexpr Range<std::int64_t> max_command_bytes_range{256, 1024 * 1024};
+    /// A command `id` is echoed in its result, and logged, up to this many bytes.
+    std::size_t max_command_id_length = 128;
+    static constexpr Range<std::int64_t> max_command_id_length_range{8, 4096};
+    /// Commands received and not yet handled; beyond either bound they are dropped.
+    std::size_t max_queued_commands = 64;
+    static constexpr Range<std::int64_t> max_queued_commands_range{1, 4096};
+    std::size_t max_queued_command_bytes = 1024 * 1024;
+    static constexpr Range<std::int64_t> max_queued_command_bytes_range{1024, 64 * 1024 * 1024};
+    /// Publications waiting for the broker, in payload + topic bytes.
+    std::size_t outbox_max_bytes = 4 * 1024 * 1024;
+    static constexpr Range<std::int64_t> outbox_max_bytes_range{64 * 1024, 256 * 1024 * 1024};
     static constexpr std::size_t max_client_id_length = 128;
     static constexpr std::size_t max_prefix_length = 256;
 

@@ -88,6 +88,8 @@ struct RawModbusTcp : RawNode {
     FieldList<ListenAddress> listen;
     Field<std::int64_t> max_connections;
     Field<std::chrono::milliseconds> idle_timeout;
+    Field<std::chrono::milliseconds> frame_timeout;
+    Field<std::int64_t> max_connections_per_client;
     FieldList<Cidr> allow;
     RawSeq<RawRule> rules;
 };
@@ -166,6 +168,7 @@ struct RawUpstream : RawNode {
     Field<std::chrono::milliseconds> response_timeout;
     RawBackoff reconnect_backoff;
     Field<std::chrono::milliseconds> poll_period;
+    Field<std::chrono::milliseconds> sequence_max_hold;
     Field<std::chrono::milliseconds> command_ttl;
     Field<std::int64_t> queue_limit;
     RawSeq<RawUpstreamUnit> units;
@@ -200,6 +203,11 @@ struct RawMqtt : RawNode {
     RawDeadband deadband;
     Field<std::chrono::milliseconds> diag_period;
     RawBackoff reconnect_backoff;
+    Field<std::int64_t> max_command_bytes;
+    Field<std::int64_t> max_command_id_length;
+    Field<std::int64_t> max_queued_commands;
+    Field<std::int64_t> max_queued_command_bytes;
+    Field<std::int64_t> outbox_max_bytes;
 };
 
 struct RawMetricsHttp : RawNode {

@@ -45,12 +45,17 @@ RawRule parse_rule(const NodeRef& ref, DiagnosticSink& sink) {
 }
 
 RawModbusTcp parse_modbus_tcp(const NodeRef& ref, DiagnosticSink& sink) {
-    const MapReader map(ref, {"listen", "max_connections", "idle_timeout", "allow", "rules"}, sink);
+    const MapReader map(ref,
+                        {"listen", "max_connections", "idle_timeout", "frame_timeout", "max_connections_per_client",
+                         "allow", "rules"},
+                        sink);
     RawModbusTcp raw;
     map.fill(raw);
     raw.listen = read_list<ListenAddress>(map, "listen", "addresses such as 0.0.0.0:502", parse_listen_address);
     raw.max_connections = read_int(map, "max_connections");
     raw.idle_timeout = read_duration(map, "idle_timeout");
+    raw.frame_timeout = read_duration(map, "frame_timeout");
+    raw.max_connections_per_client = read_int(map, "max_connections_per_client");
     raw.allow = read_cidr_list(map, "allow");
     raw.rules = read_seq<RawRule>(map, "rules", parse_rule);
     return raw;
@@ -69,7 +74,7 @@ RawUpstreamUnit parse_upstream_unit(const NodeRef& ref, DiagnosticSink& sink) {
 RawUpstream parse_upstream(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "host", "port", "connect_timeout", "response_timeout", "reconnect_backoff",
-                         "poll_period", "command_ttl", "queue_limit", "units"},
+                         "poll_period", "command_ttl", "queue_limit", "sequence_max_hold", "units"},
                         sink);
     RawUpstream raw;
     map.fill(raw);
@@ -80,6 +85,7 @@ RawUpstream parse_upstream(const NodeRef& ref, DiagnosticSink& sink) {
     raw.response_timeout = read_duration(map, "response_timeout");
     raw.reconnect_backoff = parse_backoff(map.child("reconnect_backoff"), sink);
     raw.poll_period = read_duration(map, "poll_period");
+    raw.sequence_max_hold = read_duration(map, "sequence_max_hold");
     raw.command_ttl = read_duration(map, "command_ttl");
     raw.queue_limit = read_int(map, "queue_limit");
     raw.units = read_seq<RawUpstreamUnit>(map, "units", parse_upstream_unit);
@@ -116,7 +122,8 @@ RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"enabled", "uri", "client_id", "username", "password", "password_file", "tls", "qos",
                          "keep_alive", "clean_session", "version", "prefix", "heartbeat", "min_interval", "deadband",
-                         "diag_period", "reconnect_backoff"},
+                         "diag_period", "reconnect_backoff", "max_command_bytes", "max_command_id_length",
+                         "max_queued_commands", "max_queued_command_bytes", "outbox_max_bytes"},
                         sink);
     RawMqtt raw;
     map.fill(raw);
@@ -137,6 +144,11 @@ RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
     raw.deadband = parse_deadband(map.child("deadband"), sink);
     raw.diag_period = read_duration(map, "diag_period");
     raw.reconnect_backoff = parse_backoff(map.child("reconnect_backoff"), sink);
+    raw.max_command_bytes = read_int(map, "max_command_bytes");
+    raw.max_command_id_length = read_int(map, "max_command_id_length");
+    raw.max_queued_commands = read_int(map, "max_queued_commands");
+    raw.max_queued_command_bytes = read_int(map, "max_queued_command_bytes");
+    raw.outbox_max_bytes = read_int(map, "outbox_max_bytes");
     return raw;
 }
 

@@ -157,6 +157,11 @@ void validate_mqtt(const RawMqtt& mqtt, const std::filesystem::path& base_dir, D
         }
     }
     check_range(sink, mqtt.diag_period, MqttConfig::diag_period_range);
+    check_range(sink, mqtt.max_command_bytes, MqttConfig::max_command_bytes_range);
+    check_range(sink, mqtt.max_command_id_length, MqttConfig::max_command_id_length_range);
+    check_range(sink, mqtt.max_queued_commands, MqttConfig::max_queued_commands_range);
+    check_range(sink, mqtt.max_queued_command_bytes, MqttConfig::max_queued_command_bytes_range);
+    check_range(sink, mqtt.outbox_max_bytes, MqttConfig::outbox_max_bytes_range);
     check_backoff(sink, mqtt.reconnect_backoff, MqttConfig{}.reconnect_backoff);
 }
 

@@ -63,6 +63,8 @@ void check_modbus_tcp(const RawModbusTcp& tcp, DiagnosticSink& sink) {
     }
     check_range(sink, tcp.max_connections, ModbusTcpConfig::max_connections_range);
     check_range(sink, tcp.idle_timeout, ModbusTcpConfig::idle_timeout_range);
+    check_range(sink, tcp.frame_timeout, ModbusTcpConfig::frame_timeout_range);
+    check_range(sink, tcp.max_connections_per_client, ModbusTcpConfig::max_connections_per_client_range);
     for (const auto& rule : tcp.rules.items) {
         if (rule.ok()) {
             check_rule(rule, sink);
@@ -86,6 +88,7 @@ void check_upstream(const RawUpstream& upstream, DiagnosticSink& sink) {
                              upstream.response_timeout.absent();
     check_backoff(sink, upstream.reconnect_backoff, UpstreamConfig{}.reconnect_backoff);
     check_range(sink, upstream.poll_period, UpstreamConfig::poll_period_range);
+    check_range(sink, upstream.sequence_max_hold, UpstreamConfig::sequence_max_hold_range);
     if (check_range(sink, upstream.command_ttl, UpstreamConfig::command_ttl_range) && response_ok) {
         const auto response_timeout = upstream.response_timeout.value_or(UpstreamConfig{}.response_timeout);
         if (*upstream.command_ttl < response_timeout) {

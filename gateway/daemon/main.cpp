@@ -94,7 +94,8 @@ using namespace fieldbridge;
             const auto& stats = server->stats();
             diag["modbus_tcp"] = {{"clients", stats.connections_open},
                                   {"accepted", stats.connections_accepted},
-                                  {"refused", stats.refused_max_connections + stats.refused_not_allowed},
+                                  {"refused", stats.refused_max_connections + stats.refused_not_allowed +
+                                                  stats.refused_per_client},
                                   {"requests", stats.requests},
                                   {"exceptions", stats.exceptions_total()},
                                   {"denied", stats.denied},

@@ -36,6 +36,7 @@ void append_mbap(protocol::Bytes& out, std::uint16_t transaction_id, std::uint8_
     switch (reason) {
         case CloseReason::peer: return stats.closed_by_peer;
         case CloseReason::malformed: return stats.closed_malformed;
+        case CloseReason::frame_timeout: return stats.closed_frame_timeout;
         case CloseReason::output_overflow: return stats.closed_output_overflow;
         case CloseReason::idle: return stats.closed_idle;
         case CloseReason::io_error:
@@ -52,6 +53,7 @@ const char* to_string(CloseReason reason) noexcept {
         case CloseReason::peer: return "closed by the client";
         case CloseReason::io_error: return "socket error";
         case CloseReason::malformed: return "malformed MBAP frame";
+        case CloseReason::frame_timeout: return "frame not completed within modbus_tcp.frame_timeout";
         case CloseReason::output_overflow: return "client does not read its responses";
         case CloseReason::idle: return "idle timeout";
         case CloseReason::not_allowed: return "client no longer in the allow-list";
@@ -65,6 +67,7 @@ Connection::Connection(std::shared_ptr<ConnectionContext> context, asio::ip::tcp
     : context_(std::move(context)),
       socket_(std::move(socket)),
       idle_timer_(socket_.get_executor()),
+      frame_timer_(socket_.get_executor()),
       client_(client),
       peer_(std::move(peer)),
       rx_(context_->limits.read_buffer_bytes),
@@ -92,7 +95,10 @@ void Connection::start() {
 }
 
 void Connection::read() {
-    if (closed_ || reading_ || outstanding_ >= slots_.size() || rx_end_ == rx_.size()) return;
+    if (closed_ || reading_) return;
+    // A draining connection reads only to discard (data left unread would make the
+    // close a reset, which may destroy the answers still in flight to the client).
+    if (!draining_ && (outstanding_ >= slots_.size() || rx_end_ == rx_.size())) return;
     reading_ = true;
     socket_.async_read_some(asio::buffer(rx_.data() + rx_end_, rx_.size() - rx_end_),
                             [self = shared_from_this()](const asio::error_code& error, std::size_t count) {
@@ -114,27 +120,36 @@ void Connection::on_read(const asio::error_code& error, std::size_t count) {
         close(by_peer ? CloseReason::peer : CloseReason::io_error);
         return;
     }
+    if (draining_) {
+        rx_begin_ = rx_end_ = 0;
+        read();
+        return;
+    }
+    if (buffered() == 0 && count > 0) frame_started_ = Clock::now();
     rx_end_ += count;
-    last_activity_ = Clock::now();
     process();
     read();
 }
 
 void Connection::process() {
-    while (!closed_ && outstanding_ < slots_.size() && buffered() > 0) {
+    while (!closed_ && !draining_ && outstanding_ < slots_.size() && buffered() > 0) {
         const protocol::ByteView stream(rx_.data() + rx_begin_, buffered());
         const auto frame = protocol::decode_mbap(stream);
         if (frame.need_more()) break;
         if (frame.malformed()) {
             log(context_->log, LogLevel::warning,
-                "Modbus TCP: client {} sent a malformed MBAP header ({}); closing its connection", peer_,
-                protocol::to_string(frame.error));
-            close(CloseReason::malformed);
+                "Modbus TCP: client {} sent a malformed MBAP header ({}); answering the {} request(s) accepted "
+                "before it, then closing its connection",
+                peer_, protocol::to_string(frame.error), outstanding_);
+            start_draining();
             return;
         }
         rx_begin_ += frame.consumed;
+        // The next frame's first byte arrived at the latest now.
+        last_activity_ = frame_started_ = Clock::now();
         dispatch(frame.value.transaction_id, frame.value.unit_id, frame.value.pdu);
     }
+    if (closed_ || draining_) return;
     // Keep the partial frame at the front so the buffer always has room for a whole one.
     if (rx_begin_ == rx_end_) {
         rx_begin_ = rx_end_ = 0;
@@ -143,6 +158,44 @@ void Connection::process() {
         rx_end_ -= rx_begin_;
         rx_begin_ = 0;
     }
+    arm_frame_timer();
+}
+
+bool Connection::partial_frame_buffered() const noexcept {
+    return buffered() > 0 && protocol::decode_mbap(protocol::ByteView(rx_.data() + rx_begin_, buffered())).need_more();
+}
+
+void Connection::arm_frame_timer() {
+    if (closed_ || draining_ || frame_waiting_ || !partial_frame_buffered()) return;
+    frame_timer_.expires_at(frame_started_ + context_->config->frame_timeout);
+    frame_waiting_ = true;
+    frame_timer_.async_wait([self = shared_from_this()](const asio::error_code& error) { self->on_frame_timer(error); });
+}
+
+void Connection::on_frame_timer(const asio::error_code& /*error*/) {
+    frame_waiting_ = false;
+    if (closed_ || draining_ || !partial_frame_buffered()) return;
+    const auto timeout = context_->config->frame_timeout;
+    if (Clock::now() >= frame_started_ + timeout) {
+        log(context_->log, LogLevel::warning,
+            "Modbus TCP: client {} did not complete a frame within {} ms of its first byte ({} bytes received); "
+            "closing its connection (modbus_tcp.frame_timeout)",
+            peer_, timeout.count(), buffered());
+        close(CloseReason::frame_timeout);
+        return;
+    }
+    arm_frame_timer();  // a later frame is the one waiting now
+}
+
+void Connection::start_draining() {
+    draining_ = true;
+    rx_begin_ = rx_end_ = 0;
+    frame_timer_.cancel();
+    finish_draining();
+}
+
+void Connection::finish_draining() {
+    if (draining_ && outstanding_ == 0 && !writing_ && out_pending_.empty()) schedule_close(CloseReason::malformed);
 }
 
 void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
@@ -231,6 +284,7 @@ void Connection::complete(std::uint16_t index, std::uint32_t generation, protoco
         respond(slot.transaction_id, slot.unit, response_pdu);
     }
     if (was_full) schedule_resume();
+    finish_draining();
 }
 
 void Connection::respond_exception(std::uint16_t transaction_id, std::uint8_t unit, std::uint8_t function,
@@ -293,6 +347,7 @@ void Connection::on_write(const asio::error_code& error) {
     out_sending_.clear();  // keeps its capacity for the next batch
     last_activity_ = Clock::now();
     write();
+    finish_draining();
 }
 
 void Connection::schedule_resume() {
@@ -300,7 +355,7 @@ void Connection::schedule_resume() {
     resume_scheduled_ = true;
     asio::post(socket_.get_executor(), [self = shared_from_this()] {
         self->resume_scheduled_ = false;
-        if (self->closed_) return;
+        if (self->closed_ || self->draining_) return;
         self->process();
         self->read();
     });
@@ -366,6 +421,7 @@ void Connection::close(CloseReason reason) {
         "Modbus TCP: connection {} from {} closed: {}", client_.connection, peer_, to_string(reason));
     asio::error_code ignored;
     idle_timer_.cancel();
+    frame_timer_.cancel();
     socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
     socket_.close(ignored);
     // A target may hold this object a while longer (until it answers or drops the

@@ -7,8 +7,14 @@
 ///
 /// Bounded: at most ServerLimits::max_outstanding requests with targets (then the
 /// socket is not read until one is answered) and ServerLimits::max_output_bytes of
-/// unsent responses (then the connection is closed). A malformed MBAP header closes
-/// the connection: a TCP stream cannot be resynchronised.
+/// unsent responses (then the connection is closed). A malformed MBAP header ends
+/// the connection: a TCP stream cannot be resynchronised. Reading stops there; the
+/// requests accepted before it are still answered, then the connection closes
+/// (a client that retries must not have its write executed twice).
+///
+/// Deadlines: a frame must be complete within frame_timeout of its first byte
+/// (a client trickling bytes cannot hold a connection); the idle timeout counts
+/// from the last complete request or sent answer, not from any byte.
 ///
 /// Loop thread only. Owned by the server through shared_ptr while open; pending
 /// socket operations and the answer handlers given to targets keep it alive after
@@ -31,9 +37,10 @@ namespace fieldbridge::northbound::modbus_tcp {
 enum class CloseReason : std::uint8_t {
     peer,             ///< the client closed or reset the connection
     io_error,         ///< read or write failed otherwise
-    malformed,        ///< bad MBAP header, or a frame left incomplete until the idle timeout
+    malformed,        ///< bad MBAP header (after the requests before it were answered)
+    frame_timeout,    ///< a frame not complete within frame_timeout of its first byte
     output_overflow,  ///< the client does not read its responses
-    idle,             ///< nothing received or sent for idle_timeout
+    idle,             ///< no complete request and no answer sent for idle_timeout
     not_allowed,      ///< a reload removed the client from the allow-list
     server_stop,
 };
@@ -89,6 +96,14 @@ private:
     void schedule_close(CloseReason reason);
     void arm_idle_timer();
     void on_idle_timer(const asio::error_code& error);
+    /// Watches the partial frame at the front of the buffer (lazy: one wait per frame).
+    void arm_frame_timer();
+    void on_frame_timer(const asio::error_code& error);
+    [[nodiscard]] bool partial_frame_buffered() const noexcept;
+    /// A malformed header: stop taking requests, answer those accepted, then close.
+    void start_draining();
+    /// Closes a draining connection once nothing is owed to or waiting for the client.
+    void finish_draining();
     void notify_targets();
     void release_read_buffer();
     [[nodiscard]] std::size_t buffered() const noexcept { return rx_end_ - rx_begin_; }
@@ -96,6 +111,7 @@ private:
     std::shared_ptr<ConnectionContext> context_;
     asio::ip::tcp::socket socket_;
     asio::steady_timer idle_timer_;
+    asio::steady_timer frame_timer_;
     ClientRef client_;
     std::string peer_;
 
@@ -115,8 +131,11 @@ private:
     bool writing_ = false;
     bool close_scheduled_ = false;
 
-    std::chrono::steady_clock::time_point last_activity_;
+    std::chrono::steady_clock::time_point last_activity_;  ///< last complete request or sent answer
     bool idle_waiting_ = false;
+    std::chrono::steady_clock::time_point frame_started_;  ///< first byte of the frame at rx_begin_
+    bool frame_waiting_ = false;
+    bool draining_ = false;  ///< a malformed header was received: no more requests
     bool closed_ = false;
 };
 

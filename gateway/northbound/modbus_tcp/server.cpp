@@ -163,6 +163,17 @@ void ModbusTcpServer::on_accepted(asio::ip::tcp::socket socket) {
                                 connections_.size()));
         return;
     }
+    const auto same_client = static_cast<std::size_t>(
+        std::count_if(connections_.begin(), connections_.end(),
+                      [&](const auto& entry) { return entry.second->client().address == address; }));
+    if (same_client >= config.max_connections_per_client) {
+        ++stats.refused_per_client;
+        socket.close(error);
+        log_refusal(fmt::format("Modbus TCP: refused {}: {} connections open from that address "
+                                "(modbus_tcp.max_connections_per_client)",
+                                peer, same_client));
+        return;
+    }
     // Responses are small and gathered per connection: send them without Nagle's delay.
     socket.set_option(asio::ip::tcp::no_delay(true), error);
     const std::uint64_t id = next_connection_++;

@@ -13,6 +13,7 @@ struct ServerStats {
     std::uint64_t connections_accepted = 0;  ///< since start, refused ones excluded
     std::uint64_t refused_max_connections = 0;
     std::uint64_t refused_not_allowed = 0;   ///< client outside the allow-list
+    std::uint64_t refused_per_client = 0;    ///< max_connections_per_client reached for that address
     std::uint64_t requests = 0;              ///< complete MBAP frames received
     std::uint64_t responses = 0;             ///< responses queued for sending (normal and exception)
     std::uint64_t denied = 0;                ///< requests refused by an access rule
@@ -21,6 +22,7 @@ struct ServerStats {
     std::uint64_t late_responses = 0;        ///< answers that came after their connection closed (dropped)
     std::uint64_t closed_by_peer = 0;
     std::uint64_t closed_malformed = 0;      ///< bad protocol id, bad length, oversize, truncated
+    std::uint64_t closed_frame_timeout = 0;  ///< a frame not complete within frame_timeout of its first byte
     std::uint64_t closed_output_overflow = 0;  ///< client did not read its responses
     std::uint64_t closed_idle = 0;
     std::uint64_t closed_io_error = 0;

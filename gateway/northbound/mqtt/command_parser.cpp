@@ -370,6 +370,30 @@ OpTable ops_of(CommandSet set, std::span<const RawRegister> registers) {
     return table;
 }
 
+/// Parses @p payload; @p duplicate names the first key an object holds twice.
+/// nlohmann-json keeps the last of duplicate keys, so `{"op":"stop","op":"reset"}`
+/// would run `reset` while a log or an audit of the first key reads `stop`: such a
+/// command is refused (the parser callback sees every key in document order).
+[[nodiscard]] json parse_strict(std::string_view payload, std::string& duplicate) {
+    std::vector<std::set<std::string>> open;
+    const json::parser_callback_t check = [&](int /*depth*/, json::parse_event_t event, json& parsed) {
+        switch (event) {
+            case json::parse_event_t::object_start: open.emplace_back(); break;
+            case json::parse_event_t::object_end:
+                if (!open.empty()) open.pop_back();
+                break;
+            case json::parse_event_t::key:
+                if (!open.empty() && !open.back().insert(parsed.get<std::string>()).second && duplicate.empty()) {
+                    duplicate = parsed.get<std::string>();
+                }
+                break;
+            default: break;
+        }
+        return true;
+    };
+    return json::parse(payload, check, /*allow_exceptions=*/false);
+}
+
 }  // namespace
 
 std::string_view to_string(CommandErrorKind kind) noexcept {
@@ -392,9 +416,16 @@ std::vector<std::string_view> command_ops(CommandSet set) {
 }
 
 ParseResult parse_command(std::string_view payload, CommandSet set, std::span<const RawRegister> registers) {
-    const json command = json::parse(payload, nullptr, /*allow_exceptions=*/false);
+    std::string duplicate;
+    const json command = parse_strict(payload, duplicate);
     if (command.is_discarded() || !command.is_object()) {
         return CommandError{CommandErrorKind::bad_json, "the command must be a JSON object", json(), {}};
+    }
+    if (!duplicate.empty()) {
+        // No id echoed either: which of the duplicates would it be?
+        return CommandError{CommandErrorKind::bad_json,
+                            "key '" + duplicate + "' appears twice in one object; each key may appear once",
+                            json(), {}};
     }
     json id;
     if (const auto it = command.find("id"); it != command.end() && (it->is_string() || it->is_number())) {

@@ -25,6 +25,9 @@ BridgeSettings bridge_settings(const config::MqttConfig& config) {
     s.diag_period = config.diag_period;
     s.reconnect_initial = config.reconnect_backoff.initial;
     s.reconnect_max = config.reconnect_backoff.max;
+    s.outbox_max_bytes = config.outbox_max_bytes;
+    s.max_command_bytes = config.max_command_bytes;
+    s.max_command_id_length = config.max_command_id_length;
     return s;
 }
 
@@ -35,7 +38,7 @@ public:
           s_(std::move(settings)),
           client_(std::move(client)),
           log_(std::move(log)),
-          outbox_(s_.outbox_capacity),
+          outbox_(s_.outbox_capacity, s_.outbox_max_bytes),
           wake_timer_(io),
           diag_timer_(io),
           reconnect_timer_(io),
@@ -88,6 +91,9 @@ public:
         events.message = [weak](Message m) { if (auto self = weak.lock()) self->on_message(std::move(m)); };
         events.published = [weak](std::uint64_t id, bool ok) {
             if (auto self = weak.lock()) self->on_published(id, ok);
+        };
+        events.inbound_dropped = [weak](std::uint64_t count) {
+            if (auto self = weak.lock()) self->on_inbound_dropped(count);
         };
         client_->set_events(std::move(events));
         log(LogLevel::info, "MQTT: connecting to the broker; topics under " + s_.prefix + "/");
@@ -364,6 +370,8 @@ private:
                            {"alarm_events", s.alarm_events},
                            {"commands", s.commands},
                            {"commands_failed", s.commands_failed},
+                           {"commands_too_large", s.commands_too_large},
+                           {"commands_dropped", s.commands_dropped},
                            {"in_flight", s.in_flight},
                            {"queued", s.queued}};
         const WallTime now = WallClock::now();
@@ -388,8 +396,47 @@ private:
         handle_command(name, message);
     }
 
+    void on_inbound_dropped(std::uint64_t count) {
+        stats_.commands_dropped += count;
+        unlogged_drops_ += count;
+        const auto now = std::chrono::steady_clock::now();
+        if (last_drop_log_ != std::chrono::steady_clock::time_point{} && now - last_drop_log_ < drop_log_interval) {
+            return;
+        }
+        log(LogLevel::warning, "MQTT: " + std::to_string(unlogged_drops_) +
+                                   " received message(s) dropped unanswered: more were waiting than "
+                                   "mqtt.max_queued_commands / max_queued_command_bytes allow (a client floods the "
+                                   "cmd topics?); logged at most every " +
+                                   std::to_string(drop_log_interval.count()) + " s");
+        unlogged_drops_ = 0;
+        last_drop_log_ = now;
+    }
+
+    /// @p text cut to max_command_id_length bytes (on a UTF-8 character boundary).
+    [[nodiscard]] std::string bounded(std::string text) const {
+        if (text.size() <= s_.max_command_id_length) return text;
+        std::size_t end = s_.max_command_id_length;
+        while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+        text.resize(end);
+        return text;
+    }
+
+    /// The id as echoed and logged: a string id beyond the bound is cut.
+    [[nodiscard]] json bounded(const json& id) const {
+        return id.is_string() ? json(bounded(id.get<std::string>())) : id;
+    }
+
     void handle_command(const std::string& name, const Message& message) {
         ++stats_.commands;
+        if (message.payload.size() > s_.max_command_bytes) {
+            ++stats_.commands_too_large;
+            answer(name, json(), {},
+                   CommandOutcome{false, "too_large",
+                                  "the command is larger than " + std::to_string(s_.max_command_bytes) +
+                                      " bytes (mqtt.max_command_bytes); not read",
+                                  std::nullopt});
+            return;
+        }
         const ParseResult parsed = [&]() -> ParseResult {
             const auto it = devices_.find(name);
             if (it == devices_.end()) return parse_command(message.payload, CommandSet::generic, {});
@@ -400,11 +447,11 @@ private:
         json id;
         std::string op;
         if (const auto* error = std::get_if<CommandError>(&parsed)) {
-            id = error->id;
-            op = error->op;
+            id = bounded(error->id);
+            op = bounded(error->op);
         } else {
-            id = std::get<ParsedCommand>(parsed).id;
-            op = std::get<ParsedCommand>(parsed).op;
+            id = bounded(std::get<ParsedCommand>(parsed).id);
+            op = bounded(std::get<ParsedCommand>(parsed).op);
         }
         const auto refuse = [&](std::string kind, std::string text) {
             answer(name, id, op, CommandOutcome{false, std::move(kind), std::move(text), std::nullopt});
@@ -429,7 +476,8 @@ private:
             return;
         }
         if (const auto* error = std::get_if<CommandError>(&parsed)) {
-            refuse(std::string(to_string(error->kind)), error->message);
+            // The message may quote the op: bounded like it.
+            refuse(std::string(to_string(error->kind)), bounded(error->message));
             return;
         }
         const auto& command = std::get<ParsedCommand>(parsed);
@@ -468,6 +516,9 @@ private:
     std::uint64_t offline_id_ = 0;
     std::function<void()> stop_done_;
     BridgeStats stats_;
+    static constexpr std::chrono::seconds drop_log_interval{10};
+    std::uint64_t unlogged_drops_ = 0;
+    std::chrono::steady_clock::time_point last_drop_log_{};
 };
 
 Bridge::Bridge(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log)

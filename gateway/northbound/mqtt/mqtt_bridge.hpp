@@ -46,6 +46,11 @@ struct BridgeSettings {
     engine::Duration watch_period = std::chrono::seconds{1};
     std::size_t max_in_flight = 64;
     std::size_t outbox_capacity = 512;
+    std::size_t outbox_max_bytes = 4 * 1024 * 1024;
+    /// A larger command payload is refused (`too_large`) without being parsed.
+    std::size_t max_command_bytes = 16 * 1024;
+    /// A command's `id` (and `op`) are echoed and logged up to this many bytes.
+    std::size_t max_command_id_length = 128;
     /// How long a clean stop waits for `offline` to be acknowledged, then for the
     /// disconnect.
     std::chrono::milliseconds stop_timeout{2000};
@@ -70,6 +75,8 @@ struct BridgeStats {
     std::uint64_t alarm_events = 0;
     std::uint64_t commands = 0;
     std::uint64_t commands_failed = 0;
+    std::uint64_t commands_too_large = 0;  ///< payload over max_command_bytes
+    std::uint64_t commands_dropped = 0;    ///< over the client's inbound bound, never seen
     std::size_t in_flight = 0;
     std::size_t queued = 0;
 };

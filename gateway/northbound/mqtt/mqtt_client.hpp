@@ -26,6 +26,9 @@ struct ClientEvents {
     /// The publication @p id (from publish()) was handed over (QoS 0) or acknowledged
     /// (QoS 1/2): @p ok; or failed: !@p ok.
     std::function<void(std::uint64_t id, bool ok)> published;
+    /// @p count received messages were dropped because too many waited to be
+    /// handled (the client's inbound bound); reported at most once per loop pass.
+    std::function<void(std::uint64_t count)> inbound_dropped;
 };
 
 class Client {

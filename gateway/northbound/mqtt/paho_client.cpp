@@ -1,5 +1,7 @@
 #include "northbound/mqtt/paho_client.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <exception>
 #include <map>
@@ -9,6 +11,8 @@
 
 #include <asio/post.hpp>
 #include <mqtt/async_client.h>
+
+#include "northbound/mqtt/inbound_gate.hpp"
 
 namespace fieldbridge::northbound::mqtt {
 
@@ -44,6 +48,9 @@ PahoOptions paho_options(const config::MqttConfig& config, const std::string& wi
     o.keep_alive = std::chrono::duration_cast<std::chrono::seconds>(config.keep_alive);
     o.clean_session = config.clean_session;
     o.will = Message{will_topic, "offline", config.qos, true};
+    o.max_inbound_messages = config.max_queued_commands;
+    o.max_inbound_bytes = config.max_queued_command_bytes;
+    o.max_payload_bytes = config.max_command_bytes;
     return o;
 }
 
@@ -74,7 +81,8 @@ public:
         Handler handler_;
     };
 
-    Core(asio::io_context& io, PahoOptions options) : io_(io), options_(std::move(options)) {}
+    Core(asio::io_context& io, PahoOptions options)
+        : io_(io), options_(std::move(options)), inbound_(options_.max_inbound_messages, options_.max_inbound_bytes) {}
     Core(const Core&) = delete;
     Core& operator=(const Core&) = delete;
     ~Core() = default;
@@ -101,8 +109,21 @@ public:
         *alive_ = false;
     }
 
+    /// Paho thread: a message over the inbound bound was dropped; the loop hears of
+    /// it once, however many follow before it runs.
+    void report_drop() noexcept {
+        if (drop_report_pending_.exchange(true)) return;
+        post([](Core& c) {
+            c.drop_report_pending_ = false;
+            const std::uint64_t count = c.inbound_.take_unreported();
+            if (count > 0 && c.events_.inbound_dropped) c.events_.inbound_dropped(count);
+        });
+    }
+
     asio::io_context& io_;
     PahoOptions options_;
+    InboundGate inbound_;
+    std::atomic<bool> drop_report_pending_{false};
     std::unique_ptr<::mqtt::async_client> client_;
     ClientEvents events_;
     bool connected_ = false;
@@ -162,13 +183,21 @@ PahoClient::PahoClient(asio::io_context& io, PahoOptions options)
         std::string payload;
         try {
             topic = message->get_topic();
-            payload = message->to_string();
+            // An oversized payload is cut: the bridge refuses it by its size alone.
+            const auto& whole = message->get_payload();
+            payload.assign(whole.data(), std::min(whole.size(), core->options_.max_payload_bytes + 1));
         } catch (...) {
+            return;
+        }
+        const std::size_t bytes = topic.size() + payload.size();
+        if (!core->inbound_.admit(bytes)) {
+            core->report_drop();
             return;
         }
         const int qos = message->get_qos();
         const bool retained = message->is_retained();
-        core->post([m = Message{std::move(topic), std::move(payload), qos, retained}](Core& c) mutable {
+        core->post([m = Message{std::move(topic), std::move(payload), qos, retained}, bytes](Core& c) mutable {
+            c.inbound_.release(bytes);
             if (c.events_.message) c.events_.message(std::move(m));
         });
     });

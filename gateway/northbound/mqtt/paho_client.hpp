@@ -31,6 +31,12 @@ struct PahoOptions {
     std::chrono::seconds connect_timeout{10};
     /// QoS 1/2 publications awaiting their acknowledgement (Paho's maxInflight).
     int max_inflight = 64;
+    /// Received messages waiting for the loop: beyond either bound they are dropped.
+    std::size_t max_inbound_messages = 64;
+    std::size_t max_inbound_bytes = 1024 * 1024;
+    /// A payload is kept up to this many bytes plus one (enough for the bridge to
+    /// see it is too large without holding all of it).
+    std::size_t max_payload_bytes = 16 * 1024;
 };
 
 /// The options of @p config with the will on @p will_topic.

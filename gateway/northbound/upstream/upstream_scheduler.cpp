@@ -71,6 +71,16 @@ bool UpstreamScheduler::eligible(const Entry& entry, std::size_t index) const {
         if (entry.request.request_class.role(r) == Role::none) continue;
         const Lock& lock = locks_[index_of(r)];
         if (lock.owner && *lock.owner != entry.request.client) return false;
+        if (entry.request.request_class.role(r) == Role::begin && lock.owner != entry.request.client) {
+            // A new set-up waits behind other clients' earlier requests to the resource.
+            for (std::size_t j = 0; j < index; ++j) {
+                const Entry& earlier = queue_[j];
+                if (!earlier.request.poll && earlier.request.client != entry.request.client &&
+                    earlier.request.request_class.role(r) != Role::none) {
+                    return false;
+                }
+            }
+        }
         // A client's own requests to one resource keep their order (its counter
         // read must not overtake its counter select, whatever their classes).
         for (std::size_t j = 0; j < index; ++j) {
@@ -132,13 +142,26 @@ void UpstreamScheduler::on_dispatch(const Entry& entry, TimePoint now) {
         Lock& lock = locks_[index_of(r)];
         if (role == Role::begin && !lock.owner) {
             lock.owner = entry.request.client;
+            lock.taken = now;
             log_(engine::LogLevel::debug,
                  fmt::format("upstream: client {} begins a {} sequence", entry.request.client, to_string(r)));
         }
         if (lock.owner == entry.request.client) {
-            lock.lapses = now + settings_.response_timeout + settings_.sequence_hold;
+            lock.lapses = lapse_time(lock, now + settings_.response_timeout + settings_.sequence_hold);
         }
     }
+}
+
+TimePoint UpstreamScheduler::lapse_time(const Lock& lock, TimePoint idle_until) const {
+    return std::min(idle_until, lock.taken + settings_.sequence_max_hold);
+}
+
+bool UpstreamScheduler::owner_busy(Resource resource) const {
+    const Lock& lock = locks_[index_of(resource)];
+    return lock.owner && std::any_of(flight_.begin(), flight_.end(), [&](const Entry& e) {
+               return !e.request.poll && e.request.client == *lock.owner &&
+                      e.request.request_class.role(resource) != Role::none;
+           });
 }
 
 void UpstreamScheduler::on_finished(const Entry& entry, bool answered, bool exception, TimePoint now) {
@@ -152,8 +175,10 @@ void UpstreamScheduler::on_finished(const Entry& entry, bool answered, bool exce
         } else if (role == Role::begin && (!answered || exception)) {
             // Nothing was selected (or nobody knows what was): no sequence to protect.
             release(r, answered ? "the set-up was refused" : "the set-up got no answer");
+        } else if (now >= lock.taken + settings_.sequence_max_hold) {
+            release(r, "held for sequence_max_hold; other clients may use it now");
         } else {
-            lock.lapses = now + settings_.sequence_hold;
+            lock.lapses = lapse_time(lock, now + settings_.sequence_hold);
         }
     }
 }
@@ -229,17 +254,14 @@ void UpstreamScheduler::tick(TimePoint now) {
     expire_commands(now);
     for (const Resource r : all_resources) {
         Lock& lock = locks_[index_of(r)];
-        if (!lock.owner || lock.lapses > now) continue;
-        const bool busy = std::any_of(flight_.begin(), flight_.end(), [&](const Entry& e) {
-            return !e.request.poll && e.request.client == *lock.owner &&
-                   e.request.request_class.role(r) != Role::none;
-        });
-        if (!busy) {
-            log_(engine::LogLevel::info,
-                 fmt::format("upstream: client {}'s {} sequence lapsed (idle for sequence_hold); other "
-                             "clients may use it now", *lock.owner, to_string(r)));
-            lock.owner.reset();
-        }
+        // A lock whose owner has a request in flight lapses when that is answered (on_finished).
+        if (!lock.owner || lock.lapses > now || owner_busy(r)) continue;
+        log_(engine::LogLevel::info,
+             fmt::format("upstream: client {}'s {} sequence lapsed ({}); other clients may use it now",
+                         *lock.owner, to_string(r),
+                         now >= lock.taken + settings_.sequence_max_hold ? "held for sequence_max_hold"
+                                                                         : "idle for sequence_hold"));
+        lock.owner.reset();
     }
 }
 
@@ -271,8 +293,9 @@ std::optional<TimePoint> UpstreamScheduler::next_deadline() const {
     for (const Entry& e : queue_) {
         if (e.deadline) consider(*e.deadline);
     }
-    for (const Lock& lock : locks_) {
-        if (lock.owner) consider(lock.lapses);
+    for (const Resource r : all_resources) {
+        const Lock& lock = locks_[index_of(r)];
+        if (lock.owner && !owner_busy(r)) consider(lock.lapses);
     }
     return at;
 }

@@ -14,8 +14,11 @@
 /// - stateful R6 sequences never interleave: a client that begins one (the counter
 ///   ID write to 0x0883, the data-source set-up at 0x7532...) holds that resource
 ///   until the sequence finishes, lapses (`sequence_hold` without the owner touching
-///   it) or the client closes; meanwhile other clients' requests touching the
-///   resource wait, and a client's own requests to a resource keep their order.
+///   it, or `sequence_max_hold` after it began, whatever the owner does) or the
+///   client closes; meanwhile other clients' requests touching the resource wait,
+///   and a client's own requests to a resource keep their order. A set-up never
+///   overtakes another client's request to the same resource that came before it, so
+///   a client that keeps re-selecting cannot keep a resource from the others.
 ///
 /// Outcomes are collected, never called from inside a method: the I/O layer takes
 /// them with take_completions() and calls them on the loop (so a handler may submit).
@@ -69,6 +72,9 @@ struct SchedulerSettings {
     Duration command_ttl = std::chrono::seconds{1};
     Duration poll_period = std::chrono::milliseconds{500};  ///< polls older than this are aged up
     Duration sequence_hold = std::chrono::seconds{2};       ///< an idle sequence lapses after this
+    /// A sequence lapses this long after it began, however busy its owner keeps it
+    /// (once its request in flight, if any, is answered).
+    Duration sequence_max_hold = std::chrono::milliseconds{500};
 };
 
 /// A request to put on the connection now.
@@ -128,6 +134,7 @@ private:
     struct Lock {
         std::optional<std::uint64_t> owner;
         TimePoint lapses{};
+        TimePoint taken{};  ///< when the owner began: the hold ends by taken + sequence_max_hold
     };
 
     [[nodiscard]] bool eligible(const Entry& entry, std::size_t index) const;
@@ -136,6 +143,10 @@ private:
     void on_dispatch(const Entry& entry, TimePoint now);
     void on_finished(const Entry& entry, bool answered, bool exception, TimePoint now);
     void release(Resource resource, const char* why);
+    /// The lock's lapse time after the owner's activity at @p now (capped by the maximum hold).
+    [[nodiscard]] TimePoint lapse_time(const Lock& lock, TimePoint idle_until) const;
+    /// The owner of @p resource has a request touching it in flight.
+    [[nodiscard]] bool owner_busy(Resource resource) const;
     void complete(Entry& entry, UpstreamStatus status, protocol::Bytes pdu = {});
     void expire_commands(TimePoint now);
 

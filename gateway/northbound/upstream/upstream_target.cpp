@@ -11,6 +11,7 @@
 #include "northbound/upstream/upstream_scheduler.hpp"
 #include "protocol/gateway_exceptions.hpp"
 #include "protocol/mbap_frame.hpp"
+#include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::northbound::upstream {
 namespace {
@@ -43,6 +44,7 @@ SchedulerSettings scheduler_settings(const config::UpstreamConfig& c, const Upst
     s.command_ttl = c.command_ttl;
     s.poll_period = c.poll_period;
     s.sequence_hold = t.sequence_hold;
+    s.sequence_max_hold = c.sequence_max_hold;
     return s;
 }
 
@@ -126,11 +128,40 @@ public:
         request.unit = unit->config.upstream_unit;
         request.pdu.assign(pdu.begin(), pdu.end());
         request.request_class = *classified.request;
-        request.done = [done = std::move(done), function](const UpstreamOutcome& outcome) {
+        request.done = [weak = weak_from_this(), done = std::move(done), function, unit_id,
+                        asked = request.pdu](const UpstreamOutcome& outcome) {
+            const auto self = weak.lock();
+            if (self && outcome.status == UpstreamStatus::ok) {
+                if (self->reply_malformed(unit_id, asked, outcome.response_pdu)) {
+                    done(exception_pdu(function, ExceptionCode::server_device_failure));
+                    return;
+                }
+            }
             done(answer_pdu(function, outcome));
         };
         scheduler_.submit(std::move(request), Clock::now());
         pump();
+    }
+
+    /// What is wrong with the upstream's reply to a client request (empty: nothing).
+    /// A reply that does not fit its request (an exception of another length than 2,
+    /// another quantity, a byte count its data does not match, another echo of a
+    /// write) never reaches the client: it would read garbage as data.
+    [[nodiscard]] bool reply_malformed(std::uint8_t unit_id, const protocol::Bytes& asked,
+                                       const protocol::Bytes& reply) {
+        const auto request = protocol::decode_request(asked);
+        if (!request.complete()) return false;  // the client's own business (it was forwarded as it came)
+        const auto decoded = protocol::decode_response(reply, request.value);
+        if (!decoded.malformed()) return false;
+        ++stats_.malformed_replies;
+        if (log_.enabled(engine::LogLevel::warning)) {
+            log_(engine::LogLevel::warning,
+                 fmt::format("upstream {}: unit {} sent a malformed reply to function 0x{:02X} ({}; {} bytes, "
+                             "first 0x{:02X}); the client gets exception 0x04, nothing of it is passed on",
+                             config_.name, unit_id, asked.empty() ? 0 : asked[0],
+                             protocol::to_string(decoded.error), reply.size(), reply.empty() ? 0 : reply[0]));
+        }
+        return true;
     }
 
     void client_closed(std::uint64_t connection) {

@@ -9,7 +9,9 @@
 ///   0x0A unknown unit / upstream not connected / target stopped (never sent),
 ///   0x0B no reply within response_timeout, the connection dropped while the request
 ///   was out, or a command that waited past command_ttl (never sent), 0x06 queue full,
-///   0x01 / 0x03 a PDU no function code can carry (never sent).
+///   0x01 / 0x03 a PDU no function code can carry (never sent), 0x04 a reply that
+///   does not fit its request (exception length, byte count, quantity, write echo:
+///   protocol::decode_response), counted and logged, never passed on.
 /// - queue discipline and stateful sequences: UpstreamScheduler.
 /// - state polling: every poll_period each unit's R6 state (r6_state.hpp) is read at
 ///   poll priority into a register image and decoded; a callback reports changes.
@@ -67,6 +69,7 @@ struct UpstreamStats {
     std::uint64_t forwarded = 0;     ///< frames sent upstream (polls included)
     std::uint64_t replies = 0;       ///< replies matched to a request
     std::uint64_t late_replies = 0;  ///< replies nobody waited for any more
+    std::uint64_t malformed_replies = 0;  ///< replies that did not fit their request: answered 0x04
     std::uint64_t timeouts = 0;
     std::uint64_t expired = 0;
     std::uint64_t queue_full = 0;

@@ -50,9 +50,29 @@ protocol::Bytes R6Model::handle_pdu(protocol::ByteView request_pdu, Clock::time_
     }
     const auto decoded = decode_or_exception(request_pdu);
     if (const auto* error = std::get_if<protocol::Response>(&decoded)) {
-        return protocol::encode_response(*error);
+        return malformed(request_pdu, protocol::encode_response(*error));
     }
-    return protocol::encode_response(dispatch(std::get<protocol::Request>(decoded)));
+    return malformed(request_pdu, protocol::encode_response(dispatch(std::get<protocol::Request>(decoded))));
+}
+
+protocol::Bytes R6Model::malformed(protocol::ByteView request_pdu, protocol::Bytes reply) const {
+    if (malform_ == Malform::off || request_pdu.size() < 3 || protocol::get_u16_be(request_pdu, 1) != malform_address_) {
+        return reply;
+    }
+    const std::uint8_t function = request_pdu[0];
+    switch (malform_) {
+        case Malform::long_exception:  // an exception PDU is 2 bytes
+            return {static_cast<std::uint8_t>(function | fc::exception_flag), 0x02, 0x00, 0x00};
+        case Malform::extra_registers: {  // 100 registers, whatever was asked
+            protocol::Bytes out{function, 200};
+            out.resize(202, 0x11);
+            return out;
+        }
+        case Malform::byte_count:  // announces 250 bytes, carries 2
+            return {function, 250, 0x00, 0x01};
+        case Malform::off: break;
+    }
+    return reply;
 }
 
 protocol::Response R6Model::dispatch(const protocol::Request& request) {
@@ -311,9 +331,25 @@ std::string R6Model::control(std::string_view command, Clock::time_point now) {
         inputs_[static_cast<std::size_t>(*board)] = static_cast<std::uint32_t>(*value);
         return {};
     }
+    if (words.size() >= 2 && words[0] == "malform") {
+        static const std::map<std::string_view, Malform> kinds{{"off", Malform::off},
+                                                               {"long_exception", Malform::long_exception},
+                                                               {"extra_registers", Malform::extra_registers},
+                                                               {"byte_count", Malform::byte_count}};
+        const auto kind = kinds.find(words[1]);
+        const auto address = arg(2);
+        if (kind == kinds.end() || (kind->second != Malform::off && (words.size() != 3 || !address || *address < 0 ||
+                                                                     *address > 0xFFFF))) {
+            return error("malform needs off, or long_exception | extra_registers | byte_count and a register "
+                         "address (replies to requests starting there are corrupted)");
+        }
+        malform_ = kind->second;
+        malform_address_ = kind->second == Malform::off ? 0 : static_cast<std::uint16_t>(*address);
+        return {};
+    }
     return unknown_control("r6", command,
                            "start, stop, alarm <n>, clear, mode <n>, io_boards <n>, axes <n>, "
-                           "origin <0|1>, input <board> <value>");
+                           "origin <0|1>, input <board> <value>, malform <kind> <address> | off");
 }
 
 }  // namespace fieldbridge::sim

@@ -143,6 +143,13 @@ private:
     std::uint16_t upload_points_ = 0;
     std::uint16_t upload_clear_ = 0;
 
+    /// Fault mode (control "malform KIND ADDRESS"): replies to requests starting at
+    /// `malform_address_` are corrupted, to test a master's reply validation.
+    enum class Malform : std::uint8_t { off, long_exception, extra_registers, byte_count };
+    [[nodiscard]] protocol::Bytes malformed(protocol::ByteView request_pdu, protocol::Bytes reply) const;
+    Malform malform_ = Malform::off;
+    std::uint16_t malform_address_ = 0;
+
     // Motion: the sweep phase in thousandths of a degree of axis 0 and its remainder.
     std::int64_t phase_ = 0;
     std::int64_t phase_remainder_ = 0;  ///< units x ns not yet turned into a whole unit

@@ -147,6 +147,13 @@ upstreams:
     CHECK(tcp.listen[0] == ListenAddress{"0.0.0.0", 502});
     CHECK(tcp.max_connections == 64);
     CHECK(tcp.idle_timeout == 60s);
+    CHECK(tcp.frame_timeout == 5s);
+    CHECK(config->mqtt.max_command_bytes == 16384);
+    CHECK(config->mqtt.max_command_id_length == 128);
+    CHECK(config->mqtt.max_queued_commands == 64);
+    CHECK(config->mqtt.max_queued_command_bytes == 1024 * 1024);
+    CHECK(config->mqtt.outbox_max_bytes == 4 * 1024 * 1024);
+    CHECK(tcp.max_connections_per_client == 16);
     CHECK(tcp.allow.empty());
     CHECK(tcp.rules.empty());
 
@@ -261,6 +268,8 @@ gateway: {id: t, log_level: debug}
 modbus_tcp:
   listen: ["[::1]:1502", "127.0.0.1:1502"]
   idle_timeout: 0ms
+  frame_timeout: 750ms
+  max_connections_per_client: 2
 lines:
   - name: a
     port: /dev/ttyS0
@@ -279,6 +288,8 @@ lines:
     CHECK(config->gateway.log_level == LogLevel::debug);
     CHECK(config->modbus_tcp.listen.at(0).host == "::1");
     CHECK(config->modbus_tcp.idle_timeout == 0ms);
+    CHECK(config->modbus_tcp.frame_timeout == 750ms);
+    CHECK(config->modbus_tcp.max_connections_per_client == 2);
     const auto& line = config->lines.at(0);
     CHECK(line.baud == 1200);
     CHECK(line.parity == Parity::even);

@@ -55,6 +55,43 @@ modbus_tcp:
                   "needs brackets");
 }
 
+TEST_CASE("modbus_tcp: frame deadline and per-client connection cap") {
+    const char* yaml = R"(
+gateway: {id: t}
+modbus_tcp:
+  frame_timeout: 5ms
+  max_connections_per_client: 0
+)";
+    CHECK_REPORTS(yaml, "modbus_tcp.frame_timeout", 3, 18, "expected 10ms..1min");
+    CHECK_REPORTS(yaml, "modbus_tcp.max_connections_per_client", 4, 31, "expected 1..1024");
+    CHECK(diagnostics_of(yaml).size() == 2);
+    CHECK_REPORTS("gateway: {id: t}\nmodbus_tcp: {frame_timeout: 2min}\n", "modbus_tcp.frame_timeout", 2, 29,
+                  "expected 10ms..1min");
+    CHECK(diagnostics_of("gateway: {id: t}\nmodbus_tcp: {frame_timeout: 60s, max_connections_per_client: 1024}\n")
+              .empty());
+}
+
+TEST_CASE("mqtt command bounds, outbox bytes and the upstream sequence hold are range-checked") {
+    const char* yaml = R"(
+gateway: {id: t}
+upstreams:
+  - {name: r6, host: 127.0.0.1, sequence_max_hold: 5ms, units: [{unit_id: 50, name: r6}]}
+mqtt:
+  max_command_bytes: 100
+  max_command_id_length: 5000
+  max_queued_commands: 0
+  max_queued_command_bytes: 10
+  outbox_max_bytes: 1024
+)";
+    CHECK_REPORTS(yaml, "upstreams[0].sequence_max_hold", 3, 52, "expected 10ms..10s");
+    CHECK_REPORTS(yaml, "mqtt.max_command_bytes", 5, 22, "expected 256..1048576");
+    CHECK_REPORTS(yaml, "mqtt.max_command_id_length", 6, 26, "expected 8..4096");
+    CHECK_REPORTS(yaml, "mqtt.max_queued_commands", 7, 24, "expected 1..4096");
+    CHECK_REPORTS(yaml, "mqtt.max_queued_command_bytes", 8, 29, "expected 1024..67108864");
+    CHECK_REPORTS(yaml, "mqtt.outbox_max_bytes", 9, 21, "expected 65536..268435456");
+    CHECK(diagnostics_of(yaml).size() == 6);
+}
+
 TEST_CASE("upstreams") {
     const char* yaml = R"(
 gateway: {id: t}

@@ -89,7 +89,7 @@ extra: 1
 )";
     CHECK_REPORTS(yaml, "gateway.colour", 3, 3, "unknown key 'colour'", "allowed keys here: id, log_level");
     CHECK_REPORTS(yaml, "modbus_tcp.listen_on", 5, 3, "unknown key 'listen_on'",
-                  "listen, max_connections, idle_timeout, allow, rules");
+                  "listen, max_connections, idle_timeout, frame_timeout, max_connections_per_client, allow, rules");
     CHECK_REPORTS(yaml, "modbus_tcp.rules[0].unit", 8, 7, "did you mean 'units'?");
     CHECK_REPORTS(yaml, "modbus_tcp.rules[0].registers.too", 9, 35, "did you mean 'to'?", "from, to");
     CHECK_REPORTS(yaml, "lines[0].baudrate", 13, 5, "unknown key 'baudrate' (did you mean 'baud'?)");

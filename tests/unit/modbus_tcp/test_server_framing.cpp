@@ -149,18 +149,30 @@ TEST_CASE("a malformed MBAP header closes only that connection") {
     }
 }
 
-TEST_CASE("a valid frame ahead of a malformed one reaches its target; its late answer is dropped safely") {
-    Harness h(loopback_config(), {}, [](Harness& self) { self.add_target<ImmediateTarget>({1}); });
+TEST_CASE("requests ahead of a malformed header are answered before the close; nothing after it is read") {
+    Harness h(loopback_config(), {}, [](Harness& self) { self.add_target<DelayedTarget>({1}); });
     Client client(h.port);
-    Bytes both = read_registers(40, 1, 0, 1);
-    const Bytes bad = raw_frame(41, 7, 6, Bytes{1, 0x03, 0, 0, 0, 1});
-    both.insert(both.end(), bad.begin(), bad.end());
-    REQUIRE(client.send(both));
+    // A write the target answers after 150 ms, a local 0x0A, the bad header, then a
+    // request that must not be taken.
+    Bytes stream = write_register(40, 1, 150, 7);
+    for (const Bytes& next : {read_registers(41, 9, 0, 1), raw_frame(42, 7, 6, Bytes{1, 0x03, 0, 0, 0, 1}),
+                              read_registers(43, 1, 0, 1)}) {
+        stream.insert(stream.end(), next.begin(), next.end());
+    }
+    REQUIRE(client.send(stream));
+    std::vector<std::uint16_t> answered;
+    for (int i = 0; i < 2; ++i) {
+        const auto frame = client.receive();
+        REQUIRE(frame);
+        answered.push_back(frame->transaction_id);
+    }
+    CHECK(answered == std::vector<std::uint16_t>{41, 40});
     CHECK(client.closed_within(wait_limit));
-    CHECK(h.wait_for_stats([](const ServerStats& s) {
-        return s.closed_malformed == 1 && s.requests == 1 && s.late_responses == 1;
-    }));
-    CHECK(h.on_loop([&] { return dynamic_cast<ImmediateTarget&>(*h.targets[0]).closed.size(); }) == 1);
+    CHECK(h.wait_for_stats([](const ServerStats& s) { return s.closed_malformed == 1 && s.requests == 2; }));
+    const auto stats = h.stats();
+    CHECK(stats.late_responses == 0);
+    CHECK(stats.connections_open == 0);
+    CHECK(h.on_loop([&] { return dynamic_cast<DelayedTarget&>(*h.targets[0]).seen.size(); }) == 1);
 }
 
 }  // namespace

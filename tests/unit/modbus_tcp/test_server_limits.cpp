@@ -19,6 +19,7 @@ T& target(Harness& h, std::size_t index = 0) {
 TEST_CASE("beyond max_connections new connections are closed at once; the others work") {
     auto config = loopback_config();
     config.max_connections = 64;
+    config.max_connections_per_client = 1024;  // all of them come from 127.0.0.1
     Harness h(config, {}, [](Harness& self) { self.add_target<ImmediateTarget>({1}); });
     constexpr std::size_t attempts = 500;
     std::vector<std::unique_ptr<Client>> clients;
@@ -103,6 +104,72 @@ TEST_CASE("idle connections close after idle_timeout; an incomplete frame counts
     CHECK(response->transaction_id == 5);
     CHECK(waiting.closed_within(wait_limit));  // idle again once answered
     CHECK(h.wait_for_stats([](const ServerStats& s) { return s.closed_idle == 2; }));
+}
+
+TEST_CASE("a frame not complete within frame_timeout of its first byte closes the connection") {
+    auto config = loopback_config();
+    config.frame_timeout = std::chrono::milliseconds{300};
+    Harness h(config, {}, [](Harness& self) { self.add_target<ImmediateTarget>({1}); });
+    Client slow(h.port);
+    Client good(h.port);
+    REQUIRE(slow.send(Bytes{0x00, 0x01, 0x00}));
+    const auto sent_at = std::chrono::steady_clock::now();
+    CHECK(good.ask(read_registers(1, 1, 0, 1)));  // others are not held up
+    CHECK(slow.closed_within(wait_limit));
+    CHECK(std::chrono::steady_clock::now() - sent_at >= 250ms);
+    CHECK(h.wait_for_stats([](const ServerStats& s) { return s.closed_frame_timeout == 1; }));
+    const auto lines = h.log_lines();
+    CHECK(std::any_of(lines.begin(), lines.end(), [](const std::string& line) {
+        return line.find("frame_timeout") != std::string::npos && line.find("127.0.0.1:") != std::string::npos;
+    }));
+    // Complete frames, however many and however split, never meet the deadline.
+    Client busy(h.port);
+    const Bytes request = read_registers(9, 1, 4, 1);
+    for (int i = 0; i < 8; ++i) {
+        REQUIRE(busy.send(ByteView(request).first(5)));
+        REQUIRE(busy.send(ByteView(request).subspan(5)));
+        const auto response = busy.receive();
+        REQUIRE(response);
+        CHECK(response->transaction_id == 9);
+    }
+    CHECK_FALSE(busy.closed_within(400ms));
+}
+
+TEST_CASE("bytes of an incomplete frame do not reset the idle timeout") {
+    auto config = loopback_config();
+    config.idle_timeout = std::chrono::milliseconds{300};
+    config.frame_timeout = std::chrono::seconds{60};
+    Harness h(config, {}, [](Harness& self) { self.add_target<ImmediateTarget>({1}); });
+    Client trickle(h.port);
+    // One byte every 50 ms of a 12-byte frame: it would complete after 550 ms.
+    const Bytes request = read_registers(1, 1, 0, 1);
+    std::size_t sent = 0;
+    for (; sent < request.size(); ++sent) {
+        if (!trickle.send(ByteView(request).subspan(sent, 1)) || trickle.closed_within(50ms)) break;
+    }
+    CHECK(sent < request.size());
+    CHECK(trickle.closed_within(wait_limit));
+}
+
+TEST_CASE("beyond max_connections_per_client one address's new connections are refused") {
+    auto config = loopback_config();
+    config.max_connections_per_client = 2;
+    Harness h(config, {}, [](Harness& self) { self.add_target<ImmediateTarget>({1}); });
+    auto first = std::make_unique<Client>(h.port);
+    Client second(h.port);
+    REQUIRE(h.wait_for_stats([](const ServerStats& s) { return s.connections_accepted == 2; }));
+    Client third(h.port);
+    CHECK(third.closed_within(wait_limit));
+    CHECK(h.wait_for_stats([](const ServerStats& s) { return s.refused_per_client == 1; }));
+    CHECK(second.ask(read_registers(1, 1, 0, 1)));
+    const auto lines = h.log_lines();
+    CHECK(std::any_of(lines.begin(), lines.end(), [](const std::string& line) {
+        return line.find("max_connections_per_client") != std::string::npos;
+    }));
+    first.reset();  // a freed place is taken by the next connection from that address
+    REQUIRE(h.wait_for_stats([](const ServerStats& s) { return s.connections_open == 1; }));
+    Client again(h.port);
+    CHECK(again.ask(read_registers(2, 1, 0, 1)));
 }
 
 TEST_CASE("idle_timeout 0 never closes") {

@@ -224,3 +224,51 @@ TEST_CASE("bridge: WTEC grip uses the device's init direction; unknown, nothing 
     CHECK(source->executed[0] == fp::Request{fp::WriteSingleRegisterRequest{0x0105, 0}});
     CHECK(result_of(2)["ok"] == true);
 }
+
+TEST_CASE("bridge: an oversized command is refused unread; a long id is echoed cut; duplicate keys do nothing") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    auto s = settings();
+    s.max_command_bytes = 256;
+    s.max_command_id_length = 16;
+    s.outbox_capacity = 64;
+    fm::Bridge bridge(io, s, std::make_unique<ScriptedClient>(io, log));
+    auto source = std::make_shared<FakeSource>(io, "g1");
+    bridge.set_sources({source});
+    bridge.start();
+    run(io, 20ms);
+    std::size_t acked = 0;
+    std::vector<json> results;
+    const auto settle = [&] {
+        for (int round = 0; round < 4; ++round) {
+            run(io, 10ms);
+            for (; acked < log->ids.size(); ++acked) log->events.published(log->ids[acked], true);
+        }
+        results.clear();
+        for (const auto& m : log->published) {
+            if (m.topic == "p/g1/cmd/result") results.push_back(json::parse(m.payload));
+        }
+    };
+    const std::string huge_id(300, 'x');
+    log->events.message(fm::Message{"p/g1/cmd", R"({"id":")" + huge_id + R"(","op":"stop"})", 1, false});
+    settle();
+    REQUIRE(results.size() == 1);
+    CHECK(results[0]["error"] == "too_large");
+    CHECK(results[0]["id"].is_null());
+    CHECK(bridge.stats().commands_too_large == 1);
+    const std::string long_id(200, 'y');
+    log->events.message(fm::Message{"p/g1/cmd", R"({"id":")" + long_id + R"(","op":"stop"})", 1, false});
+    settle();
+    REQUIRE(results.size() == 2);
+    CHECK(results[1]["ok"] == true);
+    CHECK(results[1]["id"] == std::string(16, 'y'));
+    CHECK(source->executed.size() == 1);
+    log->events.message(fm::Message{"p/g1/cmd", R"({"id":10,"op":"stop","op":"reset"})", 1, false});
+    settle();
+    REQUIRE(results.size() == 3);
+    CHECK(results[2]["error"] == "bad_json");
+    CHECK(source->executed.size() == 1);
+    // The client's inbound drops are counted.
+    log->events.inbound_dropped(5);
+    CHECK(bridge.stats().commands_dropped == 5);
+}

@@ -183,6 +183,22 @@ TEST_CASE("commands: invalid commands are refused with a kind and a message, ech
           CommandErrorKind::out_of_range);
 }
 
+TEST_CASE("commands: a key given twice in any object is bad_json, whichever value would win") {
+    const auto both_ops = refused(R"({"id":10,"op":"stop","op":"reset"})", fm::CommandSet::xeg);
+    CHECK(both_ops.kind == fm::CommandErrorKind::bad_json);
+    CHECK(both_ops.message.find("'op' appears twice") != std::string::npos);
+    CHECK(both_ops.id.is_null());
+    CHECK(refused(R"({"id":1,"id":2,"op":"stop"})", fm::CommandSet::xeg).kind == fm::CommandErrorKind::bad_json);
+    CHECK(refused(R"({"id":1,"op":"write_registers","table":"holding","address":1,"values":[1],"values":[2]})",
+                  fm::CommandSet::generic)
+              .kind == fm::CommandErrorKind::bad_json);
+    CHECK(refused(R"({"id":{"a":1,"a":2},"op":"stop"})", fm::CommandSet::xeg).kind == fm::CommandErrorKind::bad_json);
+    // The same key in two different objects is fine.
+    CHECK(refused(R"({"id":1,"op":"stop","x":[{"k":1},{"k":2}]})", fm::CommandSet::xeg).kind ==
+          fm::CommandErrorKind::invalid_field);
+    CHECK(requests(R"({"id":1,"op":"stop"})", fm::CommandSet::xeg).size() == 1);
+}
+
 TEST_CASE("commands: what the parser lets through, the device's profile still checks (nothing sent)") {
     fe::RegisterImage image;
     const auto xeg = fe::make_profile(fe::DeviceType::hiwin_xeg, fe::ProfileOptions{});

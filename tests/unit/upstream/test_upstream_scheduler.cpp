@@ -33,7 +33,14 @@ struct Fixture {
     Log log;
     engine::TimePoint t0 = engine::Clock::now();
 
-    explicit Fixture(SchedulerSettings st = {}) : settings(st), s(std::make_unique<UpstreamScheduler>(st)) {}
+    explicit Fixture(SchedulerSettings st = long_holds()) : settings(st), s(std::make_unique<UpstreamScheduler>(st)) {}
+
+    /// The idle lapse alone (the tests of the maximum hold set their own).
+    static SchedulerSettings long_holds() {
+        SchedulerSettings st;
+        st.sequence_max_hold = std::chrono::hours{1};
+        return st;
+    }
 
     void submit(const std::string& label, std::uint64_t client, const Bytes& pdu, engine::TimePoint at,
                 bool poll = false) {
@@ -258,4 +265,57 @@ TEST_CASE("an upload holds the data source across frames until idle") {
     CHECK(f.log.done.back().second.status == UpstreamStatus::expired);
     f.s->tick(later + f.settings.sequence_hold);
     CHECK_FALSE(f.s->owner(Resource::source_upload));
+}
+
+namespace {
+/// A scheduler with @p max_hold in which client 1 ("A") selected counter 1 at t0.
+std::unique_ptr<Fixture> counter_held_by_a(milliseconds max_hold) {
+    SchedulerSettings st;
+    st.sequence_max_hold = max_hold;
+    auto f = std::make_unique<Fixture>(st);
+    f->submit("A select", 1, counter_select_1, f->t0);
+    f->send_and_answer(f->t0);
+    return f;
+}
+}  // namespace
+
+TEST_CASE("a client that keeps re-selecting holds the counter at most sequence_max_hold") {
+    auto f = counter_held_by_a(milliseconds{500});
+    f->submit("B read", 2, counter_read, f->t0 + milliseconds{10});
+    CHECK_FALSE(f->s->next(f->t0 + milliseconds{10}));  // held by A
+    // A re-selects every 200 ms; that does not extend its hold past 500 ms.
+    f->submit("A select 2", 1, counter_select_1, f->t0 + milliseconds{200});
+    CHECK(f->send_and_answer(f->t0 + milliseconds{200}) == counter_select_1);
+    f->submit("A select 3", 1, counter_select_1, f->t0 + milliseconds{400});
+    CHECK(f->send_and_answer(f->t0 + milliseconds{400}) == counter_select_1);
+    const auto lapse = f->s->next_deadline();
+    REQUIRE(lapse);
+    CHECK(*lapse == f->t0 + milliseconds{500});
+    f->s->tick(*lapse);
+    CHECK_FALSE(f->s->owner(Resource::counter_read));
+    // A's next select came before B's read went out: it waits behind B all the same.
+    f->submit("A select 4", 1, counter_select_1, *lapse);
+    CHECK(f->send_and_answer(*lapse) == counter_read);
+    CHECK(f->send_and_answer(*lapse) == counter_select_1);
+    f->drain();
+    CHECK(f->order() == std::vector<std::string>{"A select", "A select 2", "A select 3", "B read", "A select 4"});
+}
+
+TEST_CASE("a hold past sequence_max_hold ends when the owner's request in flight is answered") {
+    auto f = counter_held_by_a(milliseconds{100});
+    const SchedulerSettings& st = f->settings;
+    f->submit("A select 2", 1, counter_select_1, f->t0 + milliseconds{90});
+    const auto in_flight = f->s->next(f->t0 + milliseconds{90});
+    REQUIRE(in_flight);
+    f->submit("B read", 2, counter_read, f->t0 + milliseconds{95});
+    // Past the maximum, but A's select is out: the deadline is its response timeout.
+    const auto deadline = f->s->next_deadline();
+    REQUIRE(deadline);
+    CHECK(*deadline == f->t0 + milliseconds{90} + st.response_timeout);
+    f->s->tick(f->t0 + milliseconds{150});
+    CHECK(f->s->owner(Resource::counter_read) == std::optional<std::uint64_t>{1});
+    CHECK(f->s->reply(in_flight->transaction_id, 1, Bytes(counter_select_1.begin(), counter_select_1.begin() + 5),
+                     f->t0 + milliseconds{160}));
+    CHECK_FALSE(f->s->owner(Resource::counter_read));
+    CHECK(f->send_and_answer(f->t0 + milliseconds{160}) == counter_read);
 }

@@ -2,6 +2,7 @@
 // remapping with pipelined requests, local answers, teardown with requests out.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <memory>
 
 #include "northbound/upstream/upstream_target.hpp"
@@ -163,4 +164,52 @@ TEST_CASE("destroyed with requests outstanding: every handler answered once, not
         CHECK(a->pdu == hex("83 0A"));
     }
     run_for(io, milliseconds{50});
+}
+
+TEST_CASE("a reply that does not fit its request is answered 0x04, counted and logged, never passed on") {
+    asio::io_context io;
+    // Reads of 0x0100 get a broken reply, chosen by the quantity asked; anything else
+    // (state polls) a refusal.
+    FakeUpstream broken(io, [](FakeUpstream& server, const FakeUpstream::Request& r) {
+        if (r.pdu[0] == 0x03 && r.pdu[1] == 0x01 && r.pdu[2] == 0x00) {
+            switch (r.pdu[4]) {
+                case 1: server.send(r.transaction_id, r.unit, hex("83 02 00 00")); return;  // 4-byte exception
+                case 2: {
+                    Bytes hundred{0x03, 200};
+                    hundred.resize(202, 0x11);
+                    server.send(r.transaction_id, r.unit, hundred);  // 100 registers for 2
+                    return;
+                }
+                case 3: server.send(r.transaction_id, r.unit, hex("03 FA 00 01")); return;  // byte count 250
+                default: server.send(r.transaction_id, r.unit, hex("03 08 00 01 00 02 00 03 00 04")); return;
+            }
+        }
+        if (r.pdu[0] == 0x06) {
+            server.send(r.transaction_id, r.unit, hex("06 4E E8 00 63"));  // echoes another value
+            return;
+        }
+        server.send(r.transaction_id, r.unit, Bytes{static_cast<std::uint8_t>(r.pdu[0] | 0x80), 0x02});
+    });
+    auto cfg = config_for(broken.port());
+    cfg.poll_period = std::chrono::hours{1};
+    CapturedLog log;
+    UpstreamTarget target(io, cfg, log.sink());
+    target.start();
+    REQUIRE(run_until(io, [&] { return target.link_state() == LinkState::up; }));
+    std::vector<std::shared_ptr<Answer>> answers;
+    for (const char* request : {"03 01 00 00 01", "03 01 00 00 02", "03 01 00 00 03", "03 01 00 00 04",
+                                "06 4E E8 00 64"}) {
+        answers.push_back(std::make_shared<Answer>());
+        target.handle(10, hex(request), client(1), capture(answers.back()));
+    }
+    REQUIRE(run_until(io, [&] {
+        return std::all_of(answers.begin(), answers.end(), [](const auto& a) { return a->done; });
+    }, milliseconds{5000}));
+    CHECK(answers[0]->pdu == hex("83 04"));
+    CHECK(answers[1]->pdu == hex("83 04"));
+    CHECK(answers[2]->pdu == hex("83 04"));
+    CHECK(answers[3]->pdu == hex("03 08 00 01 00 02 00 03 00 04"));  // a good reply passes unchanged
+    CHECK(answers[4]->pdu == hex("86 04"));
+    CHECK(target.stats().malformed_replies == 4);
+    CHECK(log.contains("malformed reply"));
 }
