@@ -228,7 +228,7 @@ TEST_CASE("bridge: WTEC grip uses the device's init direction; unknown, nothing 
 TEST_CASE("bridge: an oversized command is refused unread; a long id is echoed cut; duplicate keys do nothing") {
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
-    auto s = settings();
+    auto s = bridge_settings();
     s.max_command_bytes = 256;
     s.max_command_id_length = 16;
     s.outbox_capacity = 64;
