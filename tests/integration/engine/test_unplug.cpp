@@ -52,12 +52,12 @@ lines:
     CHECK_FALSE(excd.online());
     CHECK(xeg.image().quality(Table::input, 0x0301) == Quality::offline);
     CHECK(excd.image().quality(Table::holding, 0x0205) == Quality::offline);
-    // A client is told at once that the target cannot answer (line_down -> 0x0B).
+    // A client is told at once that the path is gone (spec §8: line_down -> 0x0A).
     const auto read_answer = h.request(xeg, read_input(0x0301));
-    CHECK_MESSAGE((read_answer && exception_of(*read_answer) == protocol::ExceptionCode::gateway_target_failed),
+    CHECK_MESSAGE((read_answer && exception_of(*read_answer) == protocol::ExceptionCode::gateway_path_unavailable),
                   describe(read_answer));
     const auto write_answer = h.request(excd, write_register(0x0001, 100));
-    CHECK_MESSAGE((write_answer && exception_of(*write_answer) == protocol::ExceptionCode::gateway_target_failed),
+    CHECK_MESSAGE((write_answer && exception_of(*write_answer) == protocol::ExceptionCode::gateway_path_unavailable),
                   describe(write_answer));
     CHECK(h.stats("excd").of(Priority::command).outcome(OutcomeStatus::line_down) == 1);
     // The other line does not care.
