@@ -73,8 +73,8 @@ class HostileWrites(Cell):
             (write_single(0x0012, 0xFFFF), 0x03),
             # Half of the EXCD203MB's 32-bit solm+ pair.
             (write_single(0x0014, 1), 0x02),
-            # The XEG model (protected).
-            (write_multiple(0x0600, [2]), 0x01),
+            # An XEG model code the manual's table does not list (0x0600 takes only those).
+            (write_multiple(0x0600, [2]), 0x03),
             # Reset and move of the XEG: a rule denies them on unit 11, so on its line's
             # broadcast unit too.
             (write_single(0x0610, 1), 0x01),
