@@ -231,20 +231,20 @@ class WtecEstopRecovery(gatewaylib.CellTestCase):
         self.assertEqual(views[WTEC_ASCII], views[WTEC_RTU], what)
         return views[WTEC_ASCII]
 
+    def step(self, client, address, value, expected, what):
+        """Writes address = value on both grippers, then settle()s on `expected`."""
+        for unit in (WTEC_ASCII, WTEC_RTU):
+            self.assert_ok(client.write_register(address, value, slave=unit))
+        return self.settle(client, expected, what)
+
     def test_estop_initialise_move_in_both_modes(self):
         self.start_cell()
         client = self.client()
-        for unit in (WTEC_ASCII, WTEC_RTU):
-            self.assert_ok(client.write_register(0x0100, 1, slave=unit))
         # Homed at the open end (direction 1): grip state 1 (reached) at 0 %.
-        self.settle(client, [0, 1, 1, 0], "after the first initialise")
-        for unit in (WTEC_ASCII, WTEC_RTU):
-            self.assert_ok(client.write_register(0x0105, 50, slave=unit))
-        self.settle(client, [0, 1, 1, 50], "at 50 %")
+        self.step(client, 0x0100, 1, [0, 1, 1, 0], "after the first initialise")
+        self.step(client, 0x0105, 50, [0, 1, 1, 50], "at 50 %")
         # E-stop: latched, motor released (grip state 11), still homed, not moved.
-        for unit in (WTEC_ASCII, WTEC_RTU):
-            self.assert_ok(client.write_register(0x0102, 1, slave=unit))
-        self.settle(client, [1, 1, 11, 50], "after the e-stop")
+        self.step(client, 0x0102, 1, [1, 1, 11, 50], "after the e-stop")
         # A move now is refused by the gripper (ASCII: `D` echoed back): 0x04 within
         # one transaction, well before the 300 ms response timeout, never 0x0B.
         for unit in (WTEC_ASCII, WTEC_RTU):
@@ -253,14 +253,9 @@ class WtecEstopRecovery(gatewaylib.CellTestCase):
             self.assertLess(time.monotonic() - started, 0.3, "unit %d: a refusal, not a timeout" % unit)
         self.assertIn("did not execute `D`", self.gateway.text())
         self.settle(client, [1, 1, 11, 50], "after the refused move")
-        # Initialise (ASCII: a1 then G) unlocks and homes both.
-        for unit in (WTEC_ASCII, WTEC_RTU):
-            self.assert_ok(client.write_register(0x0100, 1, slave=unit))
-        self.settle(client, [0, 1, 1, 0], "after the initialise")
-        # And the move is carried out on both.
-        for unit in (WTEC_ASCII, WTEC_RTU):
-            self.assert_ok(client.write_register(0x0105, 30, slave=unit))
-        self.settle(client, [0, 1, 1, 30], "after the move")
+        # Initialise (ASCII: a1 then G) unlocks and homes both; then the move is done.
+        self.step(client, 0x0100, 1, [0, 1, 1, 0], "after the initialise")
+        self.step(client, 0x0105, 30, [0, 1, 1, 30], "after the move")
 
 
 class BroadcastUnit(gatewaylib.CellTestCase):
