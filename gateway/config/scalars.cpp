@@ -29,8 +29,9 @@ struct DurationUnit {
     std::string_view suffix;
     std::int64_t ms;
 };
-// Longest suffixes first so that "ms" is not read as "m" + garbage.
-constexpr std::array<DurationUnit, 3> duration_units{{{"min", 60'000}, {"ms", 1}, {"s", 1'000}}};
+// Matched whole ("ms" is never "m" + "s"); docs/configuration.md writes ranges up
+// to 1h and 24h, so hours are a unit too.
+constexpr std::array<DurationUnit, 4> duration_units{{{"h", 3'600'000}, {"min", 60'000}, {"ms", 1}, {"s", 1'000}}};
 
 // About 24 days: far beyond any timeout or period, and small enough that sums of a
 // few durations never overflow a 64-bit count of milliseconds or nanoseconds.
@@ -74,7 +75,7 @@ Parsed<std::int64_t> parse_integer(std::string_view text) {
 Parsed<std::chrono::milliseconds> parse_duration(std::string_view text) {
     using Result = Parsed<std::chrono::milliseconds>;
     const std::string_view original = text;
-    constexpr std::string_view expected = "expected a number with a unit (ms, s or min), e.g. 250ms, 2s, 1min";
+    constexpr std::string_view expected = "expected a number with a unit (ms, s, min or h), e.g. 250ms, 2s, 1min, 1h";
     if (text.empty()) {
         return Result::fail("empty value; " + std::string(expected));
     }

@@ -53,7 +53,7 @@ ReplyScan scan_ascii(protocol::ByteView rx, std::uint8_t address, const wtec::Co
     auto framed = wtec::scan_frame(rx);
     if (framed.need_more()) return need_more();
     if (framed.malformed()) return dropped(framed.consumed, framed.error, false);
-    // decode_reply also turns the echo of an `E` request into NotHomed (seed 003,
+    // decode_reply also turns the echo of an `E` request into NotExecuted (seed 003,
     // command E: "before homing it answers without moving, returning the command").
     auto decoded = wtec::decode_reply(address, command, framed.value);
     if (!decoded.complete()) return dropped(framed.consumed, decoded.error, true);

@@ -55,7 +55,7 @@ constexpr char letter(const WriteRelease&) { return 'w'; }
 constexpr char letter(const CalibrateEncoder&) { return 'Z'; }
 
 constexpr std::array<std::string_view, std::variant_size_v<Reply>> reply_names = {
-    "Ack",   "NotHomed", "Version",       "Station",      "HomingParams", "StateCode",
+    "Ack",   "NotExecuted", "Version",       "Station",      "HomingParams", "StateCode",
     "RunningValues", "Pid", "GripperParams", "DriverParams", "ReleaseParams"};
 
 [[noreturn]] void throw_bad_value(char command, const std::string& what) {
@@ -410,10 +410,12 @@ AsciiFrame encode_reply(std::uint8_t address, const Command& command, const Repl
         case 'N': frame.data = gripper_data(reply_as<GripperParams>(cmd, reply), cmd); break;
         case 'R': frame.data = driver_data(reply_as<DriverParams>(cmd, reply), cmd); break;
         case 'W': frame.data = release_data(reply_as<ReleaseParams>(cmd, reply)); break;
+        case 'D':
         case 'E':
-            // seed 003 command 9: a drive that is not homed answers with the request
-            // itself ("返回原指令"), e.g. >01E14EA0.
-            if (std::holds_alternative<NotHomed>(reply)) {
+            // seed 003 command 9: a drive that is not homed answers `E` with the
+            // request itself ("返回原指令"), e.g. >01E14EA0; `D` is refused the same
+            // way (docs/protocols.md).
+            if (std::holds_alternative<NotExecuted>(reply)) {
                 frame.data = request_data(command);
             } else if (!std::holds_alternative<Ack>(reply)) {
                 refuse_reply(cmd, reply);
@@ -496,16 +498,16 @@ DecodeResult<Reply> decode_reply(std::uint8_t address, const Command& command,
             return fixed<Reply>(data, driver_width, [](FieldReader& in) -> Opt { return read_driver(in); });
         case 'W':
             return fixed<Reply>(data, release_width, [](FieldReader& in) -> Opt { return read_release(in); });
+        case 'D':
         case 'E': {
+            // An acknowledgement carries no data; only an exact echo of the request's
+            // data means "not executed" (seed 003 command 9, "返回原指令").
             if (data.empty()) return Result::ok(Ack{}, 0);
-            if (data.size() != 1) return Result::bad(DecodeError::bad_length, 0);
+            const std::string sent = request_data(command);
+            if (data.size() != sent.size()) return Result::bad(DecodeError::bad_length, 0);
             if (!all_hex(data)) return Result::bad(DecodeError::bad_hex, 0);
-            // Only an exact echo of the request means "not homed" (seed 003 command 9).
-            const auto digit = static_cast<std::uint8_t>(std::get<GripperAction>(command).action);
-            if (data[0] != static_cast<char>('0' + digit)) {
-                return Result::bad(DecodeError::unexpected_reply, 0);
-            }
-            return Result::ok(NotHomed{}, 0);
+            if (data != sent) return Result::bad(DecodeError::unexpected_reply, 0);
+            return Result::ok(NotExecuted{}, 0);
         }
         default:
             return empty<Reply, Ack>(data);

@@ -154,15 +154,16 @@ using Command = std::variant<ReadVersion, ReadStations, SetMotorEnable, ReadHomi
 
 // ---- replies (gripper -> host) --------------------------------------------------
 struct Ack { bool operator==(const Ack&) const = default; };  ///< reply with no data (a b C D E G i n p r U w Z)
-/// `E` answered by an echo of the request: the drive is not homed and did nothing.
-struct NotHomed { bool operator==(const NotHomed&) const = default; };
+/// `E` or `D` answered by an echo of the request: the gripper did nothing (seed 003
+/// command 9: `E` before homing; `D` likewise, e.g. with the motor released).
+struct NotExecuted { bool operator==(const NotExecuted&) const = default; };
 /// `A`: printable text of 12 (the manual's prose) or 13 characters (its CRC-verified
 /// example "Cstep [A]1.62").
 struct Version { std::string text; bool operator==(const Version&) const = default; };  // A
 struct Station { std::uint8_t address = 0; bool operator==(const Station&) const = default; };  // $
 struct StateCode { std::uint8_t code = 0; bool operator==(const StateCode&) const = default; };  // d, g
 
-using Reply = std::variant<Ack, NotHomed, Version, Station, HomingParams, StateCode, RunningValues,
+using Reply = std::variant<Ack, NotExecuted, Version, Station, HomingParams, StateCode, RunningValues,
                            Pid, GripperParams, DriverParams, ReleaseParams>;
 
 /// The reply frame a device sends for @p command (simulator side). For `i` the reply
@@ -174,7 +175,7 @@ using Reply = std::variant<Ack, NotHomed, Version, Station, HomingParams, StateC
 /// match, the address must be the one asked (for `i`, the new one; for `$`, any
 /// device address 01-FD, repeated as the data), the data length and digits exact.
 /// Otherwise malformed: wrong_address (checked first), unexpected_reply (another
-/// letter, or an `E` echo of another action), bad_length, bad_hex, bad_value (an
+/// letter, or `E` / `D` data that is not the request's own), bad_length, bad_hex, bad_value (an
 /// enable flag other than 0/1, a `$` station that differs from the frame address).
 [[nodiscard]] DecodeResult<Reply> decode_reply(std::uint8_t address, const Command& command,
                                                const AsciiFrame& frame);

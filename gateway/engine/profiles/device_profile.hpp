@@ -102,8 +102,9 @@ struct ApplyResult {
     std::optional<DeviceNotice> notice;
 };
 
-/// A decoded value for MQTT: name, value, unit ("" when none).
-using FieldValue = std::variant<bool, std::int64_t, double, std::string>;
+/// A decoded value for MQTT: name, value, unit ("" when none). A list of numbers is
+/// one value (R6 `axes_deg`, spec §6), published as a JSON array.
+using FieldValue = std::variant<bool, std::int64_t, double, std::string, std::vector<double>>;
 struct Field {
     std::string name;
     FieldValue value;

@@ -252,7 +252,14 @@ std::vector<Payload> WtecAsciiProfile::to_line(const protocol::Request& request,
         const auto address = static_cast<std::uint16_t>(span->address + i);
         const std::uint16_t value = span->values[i];
         switch (address) {
-            case initialize: out.push_back(AsciiPayload{wtec::Home{}}); break;
+            case initialize:
+                // Enable the motor first: after an e-stop (`a0`) it stays released
+                // until `a1` (seed 003 command 3), and a released gripper does not
+                // execute `D` or `E`. The RTU mode's initialise unlocks an e-stop by
+                // itself (table 2.12); this makes the view do the same.
+                out.push_back(AsciiPayload{wtec::SetMotorEnable{true}});
+                out.push_back(AsciiPayload{wtec::Home{}});
+                break;
             case estop: out.push_back(AsciiPayload{wtec::SetMotorEnable{false}}); break;
             case force: {
                 const auto current = static_cast<std::uint8_t>(wtec_force_current(value, full_current));
@@ -398,10 +405,15 @@ ApplyResult WtecAsciiProfile::apply(const Payload& sent, const Reply& reply, Reg
         result.status = ApplyStatus::not_applicable;
         return result;
     }
-    if (std::holds_alternative<wtec::NotHomed>(*answer)) {
-        // Seed 003 command 9: an echo of `E` means the drive is not homed.
-        result.status = ApplyStatus::not_applicable;
-        result.notice = DeviceNotice{0, "the gripper is not homed and ignored the command; initialise it (0x0100 = 1)"};
+    if (std::holds_alternative<wtec::NotExecuted>(*answer)) {
+        // Seed 003 command 9: the gripper echoed the command and did nothing. A
+        // refusal, not a lost reply: answered 0x04 (respond()), never a timeout.
+        result.status = ApplyStatus::device_exception;
+        result.exception = ExceptionCode::server_device_failure;
+        result.notice = DeviceNotice{
+            0, std::string{"the gripper did not execute `"} + wtec::letter_of(payload->command) +
+                   "` (it echoed the command back): its motor is released or it is not homed; initialise it "
+                   "(0x0100 = 1, MQTT op init), which enables the motor and homes"};
         return result;
     }
     if (!apply_reply(payload->command, *answer, image, now)) {
@@ -421,7 +433,10 @@ protocol::Response WtecAsciiProfile::respond(const protocol::Request& request, s
     }
     for (const Reply& reply : replies) {
         const auto* answer = std::get_if<wtec::Reply>(&reply);
-        if (answer == nullptr || std::holds_alternative<wtec::NotHomed>(*answer)) {
+        if (answer != nullptr && std::holds_alternative<wtec::NotExecuted>(*answer)) {
+            return exception_reply(function, ExceptionCode::server_device_failure);  // refused: see apply()
+        }
+        if (answer == nullptr) {
             return exception_reply(function, ExceptionCode::gateway_target_failed);
         }
         if (span->write && !std::holds_alternative<wtec::Ack>(*answer)) {

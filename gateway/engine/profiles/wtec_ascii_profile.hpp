@@ -9,7 +9,7 @@
 /// `B` (slow) and `A`, `P`, `W` (at start); an on-demand read sends the commands
 /// that fill the registers asked for. Writes become ASCII commands, one per
 /// register, in address order (FC16 over several registers: several commands):
-///   0x0100 = 1     -> `G` (home)
+///   0x0100 = 1     -> `a1` (enable the motor), then `G` (home)
 ///   0x0102 = 1     -> `a0` (release the motor); the gateway latches 0x0102 = 1
 ///                     until an acknowledged `G` clears it
 ///   0x0103 = f %   -> `C` grip current = round(f x R.max_current / 100) (C sets the
@@ -21,6 +21,8 @@
 ///   0x0303 = id    -> `i` id (protected)
 /// A write that needs device data not read yet (R for force, N for speed, B for
 /// the init direction) is answered 0x0B (gateway target failed) until it is read.
+/// A `D` (or `E`) the gripper echoes back instead of acknowledging was not executed
+/// (motor released, not homed): answered 0x04 (server device failure) with a notice.
 
 #include <cstdint>
 #include <optional>

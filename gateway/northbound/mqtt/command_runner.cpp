@@ -32,7 +32,7 @@ struct Run : std::enable_shared_from_this<Run> {
         }
         const std::size_t index = next++;
         source->execute(requests[index], [self = shared_from_this(), index](const protocol::Response& response) {
-            CommandOutcome outcome = outcome_of(response);
+            CommandOutcome outcome = outcome_of(response, self->source->type());
             if (!outcome.ok) {
                 if (index > 0) {
                     outcome.message += "; the " + std::to_string(index) + " request(s) before it were executed";
@@ -72,7 +72,7 @@ std::string describe(const protocol::Request& request) {
         request);
 }
 
-CommandOutcome outcome_of(const protocol::Response& response) {
+CommandOutcome outcome_of(const protocol::Response& response, std::string_view device_type) {
     const auto* exception = std::get_if<protocol::ExceptionResponse>(&response);
     if (exception == nullptr) {
         return CommandOutcome{};
@@ -95,6 +95,16 @@ CommandOutcome outcome_of(const protocol::Response& response) {
             outcome.error = "unavailable";
             outcome.message = "the device's line is down or being reconfigured (" + text + ")";
             break;
+        case protocol::ExceptionCode::server_device_failure:
+            if (device_type == engine::to_string(engine::DeviceType::wtec_ascii)) {
+                // The ASCII protocol has no exceptions: the view answers 0x04 when the
+                // gripper echoed `D` / `E` back instead of acting (seed 003 command 9).
+                outcome.error = "not_executed";
+                outcome.message = "the gripper did not execute the command (it echoed it back: motor released "
+                                  "or not homed; " + text + "); initialise it (op init) and send it again";
+                break;
+            }
+            [[fallthrough]];
         default:
             outcome.error = "device_exception";
             outcome.message = "the device answered " + text;

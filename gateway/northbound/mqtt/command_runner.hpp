@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <asio/io_context.hpp>
@@ -22,8 +23,9 @@ namespace fieldbridge::northbound::mqtt {
 [[nodiscard]] std::string describe(const protocol::Request& request);
 
 /// The outcome of a response that ends with a Modbus exception (the error kinds of
-/// docs/mqtt.md); ok for a normal response.
-[[nodiscard]] CommandOutcome outcome_of(const protocol::Response& response);
+/// docs/mqtt.md); ok for a normal response. @p device_type ("wtec-ascii", ...) tells
+/// what a 0x04 means: for the WTEC ASCII view a command the gripper did not execute.
+[[nodiscard]] CommandOutcome outcome_of(const protocol::Response& response, std::string_view device_type);
 
 /// @p done is called exactly once, on the loop thread, never inside run_command().
 /// The source is kept alive until then.

@@ -1,5 +1,6 @@
 #include "northbound/mqtt/state_throttle.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
 #include <variant>
@@ -18,12 +19,33 @@ namespace {
     return std::nullopt;
 }
 
+/// The largest change between two lists of the same length (R6 `axes_deg`);
+/// nullopt when either is no list or the lengths differ.
+[[nodiscard]] std::optional<double> largest_change(const engine::FieldValue& before,
+                                                   const engine::FieldValue& after) {
+    const auto* a = std::get_if<std::vector<double>>(&before);
+    const auto* b = std::get_if<std::vector<double>>(&after);
+    if (a == nullptr || b == nullptr || a->size() != b->size()) {
+        return std::nullopt;
+    }
+    double largest = 0.0;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+        largest = std::max(largest, std::fabs((*b)[i] - (*a)[i]));
+    }
+    return largest;
+}
+
 [[nodiscard]] bool field_differs(const engine::Field& before, const engine::Field& after,
                                  const std::map<std::string, double, std::less<>>& deadband) {
     if (before.value == after.value) {
         return false;
     }
     const auto band = deadband.find(after.name);
+    if (band != deadband.end()) {
+        if (const auto change = largest_change(before.value, after.value)) {
+            return *change >= band->second;  // a list moves when one of its numbers does
+        }
+    }
     const auto a = numeric(before.value);
     const auto b = numeric(after.value);
     if (band == deadband.end() || !a || !b) {

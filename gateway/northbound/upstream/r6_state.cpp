@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <fmt/format.h>
 #include <string>
+#include <vector>
 
 #include "northbound/upstream/r6_map.hpp"
 
@@ -56,6 +57,20 @@ std::optional<unsigned> axis_count(const RegisterImage& image) {
 
 double thousandths(std::int32_t raw) { return static_cast<double>(raw) / 1000.0; }
 
+/// @p count signed 32-bit values x1000 from @p address on, as numbers; nullopt unless
+/// every one is known (they are polled in one read).
+std::optional<std::vector<double>> thousandths_of(const RegisterImage& image, std::uint16_t address,
+                                                  unsigned count) {
+    std::vector<double> out;
+    out.reserve(count);
+    for (unsigned i = 0; i < count; ++i) {
+        const auto raw = signed32(image, static_cast<std::uint16_t>(address + 2 * i));
+        if (!raw) return std::nullopt;
+        out.push_back(thousandths(*raw));
+    }
+    return out;
+}
+
 std::int64_t clamp_ms(std::uint64_t ms) {
     constexpr auto max = static_cast<std::uint64_t>(INT64_MAX);
     return static_cast<std::int64_t>(ms > max ? max : ms);
@@ -100,17 +115,12 @@ engine::DecodedState decode_r6_state(const RegisterImage& image) {
     if (const auto origin = word(image, r6::origin_state)) add("origin_set", *origin != 0);
     if (const auto n = axis_count(image)) {
         add("axis_count", std::int64_t{*n});
-        for (unsigned axis = 0; axis < *n; ++axis) {
-            const auto raw = signed32(image, static_cast<std::uint16_t>(r6::axis_positions + 2 * axis));
-            // seed 004 3.1.8: axis 0 is J1; x1000 degrees.
-            if (raw) add(fmt::format("axis_{}", axis + 1), thousandths(*raw), "deg");
-        }
+        // seed 004 3.1.8: axis 0 is J1; x1000 degrees. Spec §6: one array.
+        if (auto axes = thousandths_of(image, r6::axis_positions, *n)) add("axes_deg", std::move(*axes), "deg");
     }
-    static constexpr std::array<const char*, r6::world_axes> world_names{"x", "y", "z", "u", "v", "w", "m7", "m8"};
-    for (unsigned axis = 0; axis < r6::world_axes; ++axis) {
-        const auto raw = signed32(image, static_cast<std::uint16_t>(r6::world_positions + 2 * axis));
-        // seed 004 3.1.9: x1000, in mm for every world axis.
-        if (raw) add(fmt::format("world_{}", world_names[axis]), thousandths(*raw), "mm");
+    // seed 004 3.1.9: X Y Z U V W M7 M8, x1000, in mm for every world axis.
+    if (auto world = thousandths_of(image, r6::world_positions, r6::world_axes)) {
+        add("world_mm", std::move(*world), "mm");
     }
     if (const auto ms = unsigned64(image, r6::cycle_current)) add("cycle_time", clamp_ms(*ms), "ms");
     if (const auto ms = unsigned64(image, r6::cycle_last)) add("last_cycle_time", clamp_ms(*ms), "ms");

@@ -7,9 +7,9 @@
 ///
 /// Fields (only those whose registers are known):
 ///   mode (1 manual, 2 auto, 3 configuration), mode_name, alarm, alarm_active,
-///   moving, origin_set, axis_count, axis_1..axis_N (deg), world_x, world_y, world_z,
-///   world_u, world_v, world_w, world_m7, world_m8 (mm, as the manual states),
-///   cycle_time and last_cycle_time (ms).
+///   moving, origin_set, axis_count, axes_deg (array of axis_count numbers, J1
+///   first, deg), world_mm (array X Y Z U V W M7 M8, mm as the manual states; spec
+///   §6 shows both as arrays), cycle_time and last_cycle_time (ms).
 #include <cstddef>
 #include <optional>
 #include <vector>

@@ -1,9 +1,11 @@
 """Modbus TCP through the real gateway to simulated serial devices (issue 4): the
 HIWIN XEG quick start of manual 001 Appendix 1 driven with pymodbus and mbpoll, FC06
 translated for the XEG, EXCD203MB 32-bit pairs, the WTEC ASCII uniform view against a
-WTEC RTU gripper doing the same, and a line's broadcast unit."""
+WTEC RTU gripper doing the same (also through e-stop -> initialise -> move, issue 13),
+and a line's broadcast unit."""
 
 import subprocess
+import time
 
 import gatewaylib
 
@@ -208,6 +210,52 @@ class WtecUniformView(gatewaylib.CellTestCase):
         for unit in (WTEC_ASCII, WTEC_RTU):
             self.wait_value(lambda: self.read_holding(client, 0x0204, 1, unit), [70], 5.0,
                             "position of unit %d on the object" % unit)
+
+
+class WtecEstopRecovery(gatewaylib.CellTestCase):
+    """The RTU-mode procedure e-stop (0x0102 = 1) -> initialise (0x0100 = 1) -> move
+    (0x0105 = 30) on the ASCII gripper (unit 3) and the RTU gripper (unit 4): the same
+    0x0200 init state, 0x0202 grip state and 0x0204 position after each step."""
+
+    def status(self, client, unit):
+        return [self.read_holding(client, a, 1, unit)[0] for a in (0x0102, 0x0200, 0x0202, 0x0204)]
+
+    def settle(self, client, expected, what):
+        """Waits until both grippers read `expected` (e-stop, init, grip, position) and
+        returns their readings, which must be equal."""
+        views = {}
+        for unit in (WTEC_ASCII, WTEC_RTU):
+            self.wait_value(lambda: self.status(client, unit), expected, MOTION_TIMEOUT,
+                            "0x0102, 0x0200, 0x0202, 0x0204 of unit %d %s" % (unit, what))
+            views[unit] = self.status(client, unit)
+        self.assertEqual(views[WTEC_ASCII], views[WTEC_RTU], what)
+        return views[WTEC_ASCII]
+
+    def step(self, client, address, value, expected, what):
+        """Writes address = value on both grippers, then settle()s on `expected`."""
+        for unit in (WTEC_ASCII, WTEC_RTU):
+            self.assert_ok(client.write_register(address, value, slave=unit))
+        return self.settle(client, expected, what)
+
+    def test_estop_initialise_move_in_both_modes(self):
+        self.start_cell()
+        client = self.client()
+        # Homed at the open end (direction 1): grip state 1 (reached) at 0 %.
+        self.step(client, 0x0100, 1, [0, 1, 1, 0], "after the first initialise")
+        self.step(client, 0x0105, 50, [0, 1, 1, 50], "at 50 %")
+        # E-stop: latched, motor released (grip state 11), still homed, not moved.
+        self.step(client, 0x0102, 1, [1, 1, 11, 50], "after the e-stop")
+        # A move now is refused by the gripper (ASCII: `D` echoed back): 0x04 within
+        # one transaction, well before the 300 ms response timeout, never 0x0B.
+        for unit in (WTEC_ASCII, WTEC_RTU):
+            started = time.monotonic()
+            self.assert_exception(client.write_register(0x0105, 30, slave=unit), 0x04)
+            self.assertLess(time.monotonic() - started, 0.3, "unit %d: a refusal, not a timeout" % unit)
+        self.assertIn("did not execute `D`", self.gateway.text())
+        self.settle(client, [1, 1, 11, 50], "after the refused move")
+        # Initialise (ASCII: a1 then G) unlocks and homes both; then the move is done.
+        self.step(client, 0x0100, 1, [0, 1, 1, 0], "after the initialise")
+        self.step(client, 0x0105, 30, [0, 1, 1, 30], "after the move")
 
 
 class BroadcastUnit(gatewaylib.CellTestCase):

@@ -210,7 +210,24 @@ class Commands(MqttCell):
             self.command(device, {"op": "estop"})
             self.wait_value(lambda: self.read_holding(client, 0x0102, 1, unit), [1], TIMEOUT,
                             "%s e-stop latched" % device)
+            # A move while e-stopped is refused by the gripper (RTU: exception 0x04;
+            # ASCII: `D` echoed back), an error result, never a timeout.
+            refused = self.command(device, {"op": "position", "percent": 30}, ok=False)
+            expected = "not_executed" if device == "gripper-2" else "device_exception"
+            self.assertEqual((refused["error"], refused.get("exception")), (expected, 4), refused)
+            # `init` recovers on both (ASCII: a1, then G), and the move is carried out.
             self.command(device, {"op": "init"})
+            # Grip state 1 (reached) only once homing is over (11 released before, 0 while
+            # homing); direction 1 homes at the open end, 0 %.
+            self.wait_value(lambda: self.read_holding(client, 0x0200, 1, unit)
+                            + self.read_holding(client, 0x0102, 1, unit)
+                            + self.read_holding(client, 0x0202, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [1, 0, 1, 0], MOTION_TIMEOUT,
+                            "%s initialised after the e-stop" % device)
+            self.command(device, {"op": "position", "percent": 30})
+            self.wait_value(lambda: self.read_holding(client, 0x0202, 1, unit)
+                            + self.read_holding(client, 0x0204, 1, unit), [1, 30], MOTION_TIMEOUT,
+                            "%s at 30 %% after the e-stop recovery" % device)
 
     def test_invalid_commands_do_nothing(self):
         self.start()

@@ -36,12 +36,16 @@ struct Executor {
         return ack();
     }
     Result operator()(const wtec::SetTarget& c) const {
+        // A released motor does not act: the command comes back as it was sent, as
+        // seed 003 documents for `E` (command 9, "返回原指令").
+        if (gripper.motor_released()) return wtec::NotExecuted{};
         (void)gripper.move_to(c.target, now);  // not homed: the target is only stored
         return ack();
     }
     Result operator()(const wtec::QueryGripState&) const { return wtec::StateCode{gripper.grip_state()}; }
     Result operator()(const wtec::GripperAction& c) const {
-        if (!gripper.grip_action(c.action, now)) return wtec::NotHomed{};
+        // seed 003 command 9: not homed (or released): echoed, nothing done.
+        if (!gripper.grip_action(c.action, now)) return wtec::NotExecuted{};
         return ack();
     }
     Result operator()(const wtec::Home&) const {

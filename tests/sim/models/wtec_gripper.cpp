@@ -65,10 +65,16 @@ void WtecGripper::advance(Clock::time_point now) {
     }
 }
 
+void WtecGripper::initialise(Clock::time_point now) {
+    released_ = false;  // the RTU mode has no `a`: initialising enables the motor
+    home(now);
+}
+
 void WtecGripper::home(Clock::time_point now) {
     advance(now);
-    enabled_ = true;
     estop_ = false;  // seed 003 table 2.12: the e-stop is only unlocked by initialization
+    if (released_) return;  // released by `a0`: only `a1` enables it (seed 003 command 3)
+    enabled_ = true;
     homed_ = false;
     homing_failed_ = false;
     homing_in_progress_ = true;
@@ -97,10 +103,14 @@ void WtecGripper::emergency_stop(Clock::time_point now) {
 void WtecGripper::set_motor_enabled(bool enable, Clock::time_point now) {
     advance(now);
     if (enable) {
-        if (!estop_) enabled_ = true;
+        if (!estop_) {
+            enabled_ = true;
+            released_ = false;
+        }
         return;
     }
     enabled_ = false;
+    released_ = true;
     motion_.reset();
     homing_in_progress_ = false;
 }

@@ -47,7 +47,12 @@ public:
     void advance(Clock::time_point now);
 
     // ---- actions ------------------------------------------------------------------
-    /// `G` / 0x0100 = 1: enables the motor, clears the e-stop latch, homes.
+    /// 0x0100 = 1 (Modbus-RTU face): enables the motor, clears the e-stop latch,
+    /// homes (seed 003 table 2.12: only initialising unlocks an e-stop).
+    void initialise(Clock::time_point now);
+    /// `G` (ASCII face): clears the e-stop latch, enables the motor and homes, except
+    /// after `a0`: a motor released on command stays released until `a1` (seed 003
+    /// command 3), so `G` alone is acknowledged and nothing happens.
     void home(Clock::time_point now);
     /// 0x0102 = 1: stops, releases the motor; latched until the next home().
     void emergency_stop(Clock::time_point now);
@@ -71,6 +76,9 @@ public:
     [[nodiscard]] std::uint8_t grip_state() const noexcept;
     [[nodiscard]] std::uint8_t current() const noexcept;
     [[nodiscard]] bool enabled() const noexcept { return enabled_; }
+    /// Released by `a0` (until `a1`) or e-stopped: `D` is refused (echoed) on the
+    /// ASCII face. Not at power-up: there `D` only stores the target.
+    [[nodiscard]] bool motor_released() const noexcept { return released_ || estop_; }
     [[nodiscard]] bool estop_latched() const noexcept { return estop_; }
     [[nodiscard]] bool homed() const noexcept { return homed_; }
 
@@ -134,6 +142,7 @@ private:
     bool homing_in_progress_ = false;
     bool fail_next_homing_ = false;
     bool enabled_ = false;
+    bool released_ = false;  ///< `a0` was the last `a`: only `a1` enables again
     bool estop_ = false;
     bool saved_ = false;
     bool last_action_grip_ = false;

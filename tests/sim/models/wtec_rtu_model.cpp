@@ -132,7 +132,7 @@ protocol::Response WtecRtuModel::write(const protocol::WriteSingleRegisterReques
     switch (request.address) {
         case reg_init:
             if (v != 1) return bad_value;
-            gripper_.home(now);
+            gripper_.initialise(now);
             return echo;
         case reg_estop:
             // Table 2.12: only initialization unlocks the e-stop, so 0 is not a value.

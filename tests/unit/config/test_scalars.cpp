@@ -39,6 +39,9 @@ TEST_CASE("durations need a unit") {
     CHECK(*parse_duration("1min").value == milliseconds{60000});
     CHECK(*parse_duration("1.5s").value == milliseconds{1500});
     CHECK(*parse_duration("0.25min").value == milliseconds{15000});
+    CHECK(*parse_duration("1h").value == milliseconds{3'600'000});
+    CHECK(*parse_duration("24h").value == milliseconds{86'400'000});
+    CHECK(*parse_duration("1.5h").value == milliseconds{5'400'000});
     CHECK(*parse_duration("0ms").value == milliseconds{0});
     CHECK(*parse_duration("10 ms").value == milliseconds{10});
 
@@ -49,9 +52,11 @@ TEST_CASE("durations need a unit") {
         CHECK(parsed.error.find("250ms") != std::string::npos);
     }
     SUBCASE("unknown unit") {
-        const auto parsed = parse_duration("2h");
+        const auto parsed = parse_duration("2d");
         REQUIRE_FALSE(parsed);
-        CHECK(parsed.error.find("unknown unit 'h'") != std::string::npos);
+        CHECK(parsed.error.find("unknown unit 'd'") != std::string::npos);
+        CHECK(parsed.error.find("ms, s, min or h") != std::string::npos);
+        CHECK_FALSE(parse_duration("2hr"));
         CHECK_FALSE(parse_duration("5us"));
         CHECK_FALSE(parse_duration("5mins"));
         CHECK_FALSE(parse_duration("5 m s"));

@@ -129,11 +129,39 @@ TEST_CASE("agent wtec ascii: a reply that is not an acknowledgement stops the se
     rig.request(fp::WriteMultipleRegistersRequest{0x0104, {60, 70}});
     auto sent = commands(rig.line);
     REQUIRE(sent.size() == 1);
-    rig.line.reply(sent[0], fe::Reply{fw::Reply{fw::NotHomed{}}});
+    rig.line.reply(sent[0], fe::Reply{fw::Reply{fw::StateCode{1}}});
     rig.await_answers(1);
     CHECK(rig.last_answer() == exception(fp::fc::write_multiple_registers, ExceptionCode::gateway_target_failed));
     CHECK(commands(rig.line).size() == 1);
-    REQUIRE(rig.notices.size() == 1);  // "not homed" is worth telling
+}
+
+TEST_CASE("agent wtec ascii: a D echoed back was not executed: 0x04 at once, with a notice, not 0x0B") {
+    Wtec rig;
+    rig.request(fp::WriteSingleRegisterRequest{0x0105, 30});
+    const auto sent = commands(rig.line);
+    REQUIRE(sent.size() == 1);
+    CHECK(same(rig.line.at(sent[0]).payload, ascii(fw::SetTarget{3000})));
+    rig.line.reply(sent[0], fe::Reply{fw::Reply{fw::NotExecuted{}}});
+    rig.await_answers(1);
+    CHECK(rig.last_answer() == exception(fp::fc::write_single_register, ExceptionCode::server_device_failure));
+    CHECK(commands(rig.line).size() == 1);
+    REQUIRE(rig.notices.size() == 1);  // logged and published with the reason
+    CHECK(rig.notices[0].text.find("did not execute `D`") != std::string::npos);
+}
+
+TEST_CASE("agent wtec ascii: initialise sends a1 then G") {
+    Wtec rig;
+    rig.request(fp::WriteSingleRegisterRequest{0x0100, 1});
+    auto sent = commands(rig.line);
+    REQUIRE(sent.size() == 1);
+    CHECK(same(rig.line.at(sent[0]).payload, ascii(fw::SetMotorEnable{true})));
+    rig.line.reply(sent[0], ascii_reply(rig.line.at(sent[0]), fw::Ack{}));
+    sent = commands(rig.line);
+    REQUIRE(sent.size() == 2);
+    CHECK(same(rig.line.at(sent[1]).payload, ascii(fw::Home{})));
+    rig.line.reply(sent[1], ascii_reply(rig.line.at(sent[1]), fw::Ack{}));
+    rig.await_answers(1);
+    CHECK(rig.last_answer() == fp::Response{fp::WriteSingleResponse{fp::fc::write_single_register, 0x0100, 1}});
 }
 
 TEST_CASE("agent wtec ascii: stop() between payloads ends the sequence with 0x04") {

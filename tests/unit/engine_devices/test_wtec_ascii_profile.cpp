@@ -52,7 +52,8 @@ struct View {
         for (const auto& p : profile.to_line(r, image)) out.push_back(fw::letter_of(command_of(p)));
         return out;
     }
-    /// A whole northbound exchange: validate, to_line, apply every reply, respond.
+    /// A whole northbound exchange: validate, to_line, apply every reply (up to a
+    /// refusal), respond.
     fp::Response exchange(const fp::Request& r, const std::vector<fw::Reply>& answers) {
         if (const auto bad = profile.validate(r, image)) return fp::ExceptionResponse{fp::function_of(r), *bad};
         const auto payloads = profile.to_line(r, image);
@@ -60,7 +61,13 @@ struct View {
         std::vector<fe::Reply> replies;
         for (std::size_t i = 0; i < payloads.size(); ++i) {
             replies.push_back(ascii(answers[i]));
-            CHECK(profile.apply(payloads[i], replies.back(), image, t0()).status == fe::ApplyStatus::applied);
+            const auto status = profile.apply(payloads[i], replies.back(), image, t0()).status;
+            if (std::holds_alternative<fw::NotExecuted>(answers[i])) {
+                // A refusal ends the sequence, as in the agent.
+                CHECK(status == fe::ApplyStatus::device_exception);
+                break;
+            }
+            CHECK(status == fe::ApplyStatus::applied);
         }
         return profile.respond(r, replies, image);
     }
@@ -212,9 +219,27 @@ TEST_CASE("wtec-ascii: replies fill the uniform registers and the extension bloc
     CHECK(v.feed(fw::ReadGripper{}, fw::Ack{}).status == fe::ApplyStatus::not_applicable);
     CHECK(v.profile.apply(fe::ModbusPayload{read_holding(0x0200, 1)}, registers(0x03, {1}), v.image, t0()).status ==
           fe::ApplyStatus::not_applicable);
-    const auto not_homed = v.feed(fw::GripperAction{fw::GripAction::grip}, fw::NotHomed{});
-    CHECK(not_homed.status == fe::ApplyStatus::not_applicable);
-    CHECK(not_homed.notice.has_value());
+}
+
+TEST_CASE("wtec-ascii: an E or D the gripper echoes back was not executed: 0x04, never 0x0B") {
+    View v;
+    v.polled();
+    const auto refused = v.feed(fw::GripperAction{fw::GripAction::grip}, fw::NotExecuted{});
+    CHECK(refused.status == fe::ApplyStatus::device_exception);
+    CHECK(refused.exception == ExceptionCode::server_device_failure);
+    REQUIRE(refused.notice.has_value());
+    CHECK(refused.notice->text.find("did not execute `E`") != std::string::npos);
+    // 0x0105 = 30 -> D 3000, echoed: the view keeps its old target.
+    CHECK(v.exchange(write_single(0x0105, 30), {fw::NotExecuted{}}) ==
+          fp::Response{fp::ExceptionResponse{0x06, ExceptionCode::server_device_failure}});
+    CHECK(v.image.value(Table::holding, 0x0105) == 50);
+    const auto d = v.feed(fw::SetTarget{3000}, fw::NotExecuted{});
+    REQUIRE(d.notice.has_value());
+    CHECK(d.notice->text.find("did not execute `D`") != std::string::npos);
+    CHECK(d.notice->text.find("initialise it") != std::string::npos);
+    // In an FC16 sequence the refusal ends it with 0x04 too.
+    CHECK(v.exchange(write_multiple(0x0104, {50, 30}), {fw::Ack{}, fw::NotExecuted{}}) ==
+          fp::Response{fp::ExceptionResponse{0x10, ExceptionCode::server_device_failure}});
 }
 
 TEST_CASE("wtec-ascii: on-demand reads send the commands that fill what is asked") {
@@ -272,7 +297,12 @@ TEST_CASE("wtec-ascii: writes become ASCII commands") {
         REQUIRE(out.size() == 1);
         return command_of(out[0]);
     };
-    CHECK(one(write_single(0x0100, 1)) == fw::Command{fw::Home{}});
+    // Initialise: a1 (enable the motor, released after an e-stop), then G (home).
+    CHECK(v.letters(write_single(0x0100, 1)) == "aG");
+    const auto init = v.profile.to_line(write_single(0x0100, 1), v.image);
+    REQUIRE(init.size() == 2);
+    CHECK(command_of(init[0]) == fw::Command{fw::SetMotorEnable{true}});
+    CHECK(command_of(init[1]) == fw::Command{fw::Home{}});
     CHECK(one(write_single(0x0102, 1)) == fw::Command{fw::SetMotorEnable{false}});
     CHECK(one(write_single(0x0103, 80)) == fw::Command{fw::SetPeakCurrent{80}});  // R max 100
     CHECK(one(write_single(0x0104, 50)) == fw::Command{fw::WriteGripper{gripper(5000, 80, 128)}});
@@ -325,7 +355,11 @@ TEST_CASE("wtec-ascii: acknowledged writes update the view; the e-stop latch") {
     CHECK(alarms[0].code == "emergency_stop");
     CHECK(v.exchange(read_holding(0x0102, 1), {fw::RunningValues{4800, 0, false, 0x11}}) ==
           fp::Response{fp::ReadRegistersResponse{0x03, {1}}});
-    (void)v.exchange(write_single(0x0100, 1), {fw::Ack{}});
+    // Initialise: a1 acknowledged keeps the latch; the acknowledged G clears it.
+    CHECK(v.feed(fw::SetMotorEnable{true}, fw::Ack{}).status == fe::ApplyStatus::applied);
+    CHECK(v.image.value(Table::holding, 0x0102) == 1);
+    CHECK(v.exchange(write_single(0x0100, 1), {fw::Ack{}, fw::Ack{}}) ==
+          fp::Response{fp::WriteSingleResponse{0x06, 0x0100, 1}});
     CHECK(v.image.value(Table::holding, 0x0102) == 0);
     CHECK(v.profile.alarms(v.image).empty());
 

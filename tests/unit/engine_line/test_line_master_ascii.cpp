@@ -101,7 +101,7 @@ TEST_CASE("ascii: `E` answered by its own request frame means not homed") {
     s.master.on_bytes(grip_request, s.tx_end + 2ms);
     auto done = expect_finished(s.master, s.tx_end + 2ms);
     CHECK(done.outcome.status == OutcomeStatus::ok);
-    CHECK(std::holds_alternative<wtec::NotHomed>(std::get<wtec::Reply>(done.outcome.reply)));
+    CHECK(std::holds_alternative<wtec::NotExecuted>(std::get<wtec::Reply>(done.outcome.reply)));
 }
 
 TEST_CASE("ascii: with local echo, the echo of `E` is discarded and the second copy is the reply") {
@@ -114,7 +114,7 @@ TEST_CASE("ascii: with local echo, the echo of `E` is discarded and the second c
         CHECK(std::holds_alternative<fe::line_action::Wait>(s.master.next_action(s.tx_end)));
         s.master.on_bytes(grip_request, s.tx_end + 3ms);  // the device: same bytes
         auto done = expect_finished(s.master, s.tx_end + 3ms);
-        CHECK(std::holds_alternative<wtec::NotHomed>(std::get<wtec::Reply>(done.outcome.reply)));
+        CHECK(std::holds_alternative<wtec::NotExecuted>(std::get<wtec::Reply>(done.outcome.reply)));
     }
     SUBCASE("homed: an empty acknowledgement") {
         AsciiSent s(wtec::GripperAction{wtec::GripAction::grip}, config);

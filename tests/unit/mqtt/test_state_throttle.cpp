@@ -51,6 +51,28 @@ TEST_CASE("throttle: a change below the deadband is not published; drift adds up
     CHECK(t.due(with(1.0, "idle", false), t0 + 1s));
 }
 
+TEST_CASE("throttle: a list field (R6 axes_deg) moves when one of its numbers moves past the deadband") {
+    auto axes = [](std::vector<double> values) {
+        fm::SourceState s;
+        s.online = true;
+        s.quality = fe::Quality::good;
+        s.decoded.fields = {fe::Field{"axes_deg", std::move(values), "deg"}};
+        return s;
+    };
+    auto config = throttle_settings();
+    config.deadband = {{"axes_deg", 0.1}};
+    fm::StateThrottle t(config);
+    const fe::TimePoint t0{};
+    t.published(axes({10.0, -1.0}), t0);
+    CHECK_FALSE(t.due(axes({10.05, -1.05}), t0 + 1s));
+    CHECK(t.due(axes({10.0, -1.2}), t0 + 1s));
+    CHECK(t.due(axes({10.0, -1.0, 0.0}), t0 + 1s));  // another axis count: a change
+    // Without a deadband any change counts.
+    fm::StateThrottle plain(throttle_settings());
+    plain.published(axes({10.0, -1.0}), t0);
+    CHECK(plain.due(axes({10.001, -1.0}), t0 + 1s));
+}
+
 TEST_CASE("throttle: a change waits for the minimum interval after the previous publication") {
     fm::StateThrottle t(throttle_settings());
     const fe::TimePoint t0{};

@@ -193,8 +193,8 @@ TEST_CASE("wtec vectors: cases from the notes") {
         REQUIRE(frame.complete());
         const auto reply = wtec::decode_reply(1, grip, frame.value);
         REQUIRE(reply.complete());
-        CHECK(std::holds_alternative<wtec::NotHomed>(reply.value));
-        CHECK(wtec::encode_frame_body(wtec::encode_reply(1, grip, wtec::NotHomed{})) == ">01E14EA0");
+        CHECK(std::holds_alternative<wtec::NotExecuted>(reply.value));
+        CHECK(wtec::encode_frame_body(wtec::encode_reply(1, grip, wtec::NotExecuted{})) == ">01E14EA0");
     }
     SUBCASE("i: the reply comes from the new address 0x0A") {
         const wtec::Command set = wtec::SetAddress{0x0A};

@@ -259,18 +259,36 @@ TEST_CASE("wtec commands: E replies: acknowledgement or not-homed echo") {
     CHECK(std::holds_alternative<wtec::Ack>(r.value));
     r = wtec::decode_reply(1, grip, {1, 'E', "1"});
     REQUIRE(r.complete());
-    CHECK(std::holds_alternative<wtec::NotHomed>(r.value));
+    CHECK(std::holds_alternative<wtec::NotExecuted>(r.value));
     CHECK(describe(wtec::decode_reply(1, grip, {1, 'E', "2"})) == malformed(DecodeError::unexpected_reply));
     CHECK(describe(wtec::decode_reply(1, grip, {1, 'E', "11"})) == malformed(DecodeError::bad_length));
     CHECK(describe(wtec::decode_reply(1, grip, {1, 'E', "G"})) == malformed(DecodeError::bad_hex));
     for (const auto action : {wtec::GripAction::grip, wtec::GripAction::release, wtec::GripAction::toggle}) {
         const wtec::Command command = wtec::GripperAction{action};
-        const auto echo = wtec::encode_reply(1, command, wtec::NotHomed{});
+        const auto echo = wtec::encode_reply(1, command, wtec::NotExecuted{});
         CHECK(echo == wtec::encode_command(1, command));
         r = wtec::decode_reply(1, command, echo);
         REQUIRE(r.complete());
-        CHECK(std::holds_alternative<wtec::NotHomed>(r.value));
+        CHECK(std::holds_alternative<wtec::NotExecuted>(r.value));
     }
+}
+
+TEST_CASE("wtec commands: D replies: acknowledgement or not-executed echo") {
+    // seed 003 command 7: D with an 8-digit target, acknowledged by >01D6018.
+    const wtec::Command target = wtec::SetTarget{0x0001FFFF};
+    auto r = wtec::decode_reply(1, target, {1, 'D', ""});
+    REQUIRE(r.complete());
+    CHECK(std::holds_alternative<wtec::Ack>(r.value));
+    // The echo of the request (the refusal seed 003 documents for E) is recognised.
+    const auto echo = wtec::encode_reply(1, target, wtec::NotExecuted{});
+    CHECK(echo == wtec::encode_command(1, target));
+    r = wtec::decode_reply(1, target, echo);
+    REQUIRE(r.complete());
+    CHECK(std::holds_alternative<wtec::NotExecuted>(r.value));
+    // Any other data is not an echo of this request.
+    CHECK(describe(wtec::decode_reply(1, target, {1, 'D', "0001FFFE"})) == malformed(DecodeError::unexpected_reply));
+    CHECK(describe(wtec::decode_reply(1, target, {1, 'D', "0001FFF"})) == malformed(DecodeError::bad_length));
+    CHECK(describe(wtec::decode_reply(1, target, {1, 'D', "0001FFFG"})) == malformed(DecodeError::bad_hex));
 }
 
 TEST_CASE("wtec commands: i replies come from the new address") {
@@ -310,7 +328,7 @@ TEST_CASE("wtec commands: encoders refuse values the wire cannot carry") {
     // A reply type that does not answer the command.
     CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadPid{}, wtec::Ack{}), std::invalid_argument);
     CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::Home{}, pid), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::SetTarget{}, wtec::NotHomed{}), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::Home{}, wtec::NotExecuted{}), std::invalid_argument);
     CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadVersion{}, wtec::Version{"1.62"}),
                     std::invalid_argument);
     CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadStations{}, wtec::Station{2}),

@@ -149,6 +149,33 @@ TEST_CASE("wtec-ascii: D moves in position mode, E grips and releases, a release
     CHECK(state(wtec, wtec::QueryHoming{}, clock.now()) == wtec::homing_state::not_homed);
 }
 
+TEST_CASE("wtec-ascii: after a0 the motor stays released until a1; D is echoed meanwhile") {
+    SimClock clock;
+    sim::WtecAsciiModel wtec(1, 20000);
+    REQUIRE(!exchange_ascii(wtec, body(1, wtec::Home{}), clock.now()).empty());
+    clock.advance_s(1);
+    REQUIRE(!exchange_ascii(wtec, body(1, wtec::SetTarget{10000}), clock.now()).empty());
+    clock.advance_s(1);
+    REQUIRE(running(wtec, clock.now()) == wtec::RunningValues{10000, 3, true, wtec::grip_state::reached});
+    // a0 (the view's e-stop): released. G alone does not enable it: nothing moves.
+    REQUIRE(!exchange_ascii(wtec, body(1, wtec::SetMotorEnable{false}), clock.now()).empty());
+    CHECK(exchange_ascii(wtec, ">01G6158", clock.now()) == ">01G6158");
+    clock.advance_s(1);
+    CHECK(running(wtec, clock.now()) == wtec::RunningValues{10000, 0, false, wtec::grip_state::motor_released});
+    // D is not executed: the request comes back as it was sent, the target unchanged.
+    const std::string d = body(1, wtec::SetTarget{6000});
+    CHECK(exchange_ascii(wtec, d, clock.now()) == d);
+    CHECK(wtec.gripper().gripper_params().target == 10000);
+    // a1 then G: enabled and homed again, and D moves.
+    REQUIRE(!exchange_ascii(wtec, body(1, wtec::SetMotorEnable{true}), clock.now()).empty());
+    REQUIRE(!exchange_ascii(wtec, body(1, wtec::Home{}), clock.now()).empty());
+    clock.advance_s(2);
+    CHECK(state(wtec, wtec::QueryHoming{}, clock.now()) == wtec::homing_state::homed);
+    CHECK(exchange_ascii(wtec, d, clock.now()) == ">01D6018");
+    clock.advance_s(1);
+    CHECK(running(wtec, clock.now()) == wtec::RunningValues{6000, 3, true, wtec::grip_state::reached});
+}
+
 TEST_CASE("wtec-ascii: addressing, broadcast and undecodable frames") {
     SimClock clock;
     sim::WtecAsciiModel wtec(1, 20000);

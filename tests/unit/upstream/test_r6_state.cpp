@@ -68,13 +68,16 @@ TEST_CASE("decoding: signed 32-bit x1000 high word first, 64-bit cycle times, fl
     CHECK(field<bool>(s, "moving"));
     CHECK_FALSE(field<bool>(s, "origin_set"));
     CHECK(field<std::int64_t>(s, "axis_count") == 2);
-    CHECK(field<double>(s, "axis_1") == doctest::Approx(10.0));
-    CHECK(field<double>(s, "axis_2") == doctest::Approx(-1.0));
-    CHECK(s.find("axis_3") == nullptr);
-    CHECK(field<double>(s, "world_x") == doctest::Approx(100.0));
-    CHECK(field<double>(s, "world_m8") == doctest::Approx(-0.001));
-    CHECK(s.find("world_x")->unit == "mm");
-    CHECK(s.find("axis_1")->unit == "deg");
+    // Spec §6: arrays, J1 first / X Y Z U V W M7 M8.
+    CHECK(field<std::vector<double>>(s, "axes_deg") == std::vector<double>{10.0, -1.0});
+    const auto world = field<std::vector<double>>(s, "world_mm");
+    REQUIRE(world.size() == 8);
+    CHECK(world[0] == doctest::Approx(100.0));
+    CHECK(world[7] == doctest::Approx(-0.001));
+    CHECK(s.find("world_mm")->unit == "mm");
+    CHECK(s.find("axes_deg")->unit == "deg");
+    CHECK(s.find("axis_1") == nullptr);  // no flat fields
+    CHECK(s.find("world_x") == nullptr);
     CHECK(field<std::int64_t>(s, "cycle_time") == 0x0000000100000002LL);
     CHECK(field<std::int64_t>(s, "last_cycle_time") == 6000);
     const auto alarms = r6_alarms(image);

@@ -169,9 +169,10 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
     CHECK(int_of("axis_count") == 6);
     CHECK(int_of("cycle_time") == 0);
     CHECK(r.target->state(10)->name == "robot");
-    CHECK(field("axis_6"));
-    CHECK_FALSE(field("axis_7"));
-    CHECK(field("world_m8"));
+    REQUIRE(field("axes_deg"));
+    CHECK(std::get<std::vector<double>>(field("axes_deg")->value).size() == 6);
+    REQUIRE(field("world_mm"));
+    CHECK(std::get<std::vector<double>>(field("world_mm")->value).size() == 8);
 
     REQUIRE(r.sim.control("r6 alarm 805") == "ok");
     REQUIRE(run_until(r.io, [&] { return int_of("alarm") == 805; }));
@@ -185,8 +186,9 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
     CHECK(ask(r.io, *r.target, hex("06 4e 23 00 01")) == hex("06 4e 23 00 01"));
     REQUIRE(run_until(r.io, [&] {
         const auto moving = field("moving");
-        const auto axis = field("axis_1");
-        return moving && std::get<bool>(moving->value) && axis && std::get<double>(axis->value) > 0.0 &&
+        const auto axes = field("axes_deg");
+        return moving && std::get<bool>(moving->value) && axes &&
+               std::get<std::vector<double>>(axes->value).at(0) > 0.0 &&
                int_of("cycle_time").value_or(0) > 0;
     }));
     CHECK(int_of("mode") == 2);
