@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "vectors.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "engine/register_image.hpp"
 #include "protocol/modbus_pdu.hpp"
@@ -53,17 +54,8 @@ inline const fw::Command& command_of(const fe::Payload& payload) {
     return std::get<fe::AsciiPayload>(payload).command;
 }
 
-/// "10 06 10 00 01 02 00 01".
-inline std::string hex(const fp::Bytes& bytes) {
-    static constexpr char digits[] = "0123456789ABCDEF";
-    std::string out;
-    for (const auto b : bytes) {
-        if (!out.empty()) out.push_back(' ');
-        out.push_back(digits[b >> 4]);
-        out.push_back(digits[b & 0x0F]);
-    }
-    return out;
-}
+/// "10 06 10 00 01 02 00 01" (tests/unit/protocol/vectors.hpp).
+using fieldbridge::test::hex;
 
 /// The PDU bytes of the request a payload carries.
 inline std::string pdu_hex(const fe::Payload& payload) { return hex(fp::encode_request(request_of(payload))); }
