@@ -8,6 +8,7 @@ import os
 import socket
 import struct
 import subprocess
+import threading
 import time
 
 import gatewaylib
@@ -197,6 +198,57 @@ class R6Upstream(gatewaylib.CellTestCase):
         self.assertEqual(answer[0], 2)
         self.assertEqual(answer[2][:2], b"\x03\x0c", answer)
         self.assertLess(waited, 2.0)
+
+    def test_reads_waiting_on_a_hold_do_not_crowd_out_other_reads(self):
+        # A holder re-selects the counter block again and again; three clients
+        # pipeline reads of that block, one every 50 ms between them; another reads
+        # an unrelated register. With an endless hold the waiting reads filled the
+        # queue (32) within 1.6 s and the unrelated reads were refused 0x06. Now
+        # each hold lapses after 500 ms: every read gets its registers.
+        self.start_cell(r6=True)
+        holder, other = self.raw(), self.raw()
+        waiters = [self.raw() for _ in range(3)]
+        select = struct.pack(">BHHB", 0x10, 0x0883, 2, 4) + struct.pack(">HH", 0, 0)
+        holder.sendall(mbap(1, R6, select))
+        self.assertEqual(read_frame(holder)[2][:1], b"\x10")
+        stop = threading.Event()
+        holder_errors = []
+
+        def keep_re_selecting():
+            transaction = 100
+            while not stop.is_set():
+                holder.sendall(mbap(transaction, R6, select))
+                frame = read_frame(holder)
+                if frame is None or frame[2][:1] != b"\x10":
+                    holder_errors.append(frame)
+                    return
+                transaction += 1
+                stop.wait(0.1)
+
+        thread = threading.Thread(target=keep_re_selecting, daemon=True)
+        thread.start()
+        try:
+            sent, worst_other = 0, 0.0
+            started = time.monotonic()
+            while time.monotonic() - started < 3.0:
+                waiters[sent % 3].sendall(mbap(1000 + sent, R6, read_pdu(0x0883, 6)))
+                sent += 1
+                asked = time.monotonic()
+                other.sendall(mbap(sent, R6, read_pdu(0x0082, 1)))
+                self.assertEqual(read_frame(other), (sent, R6, bytes.fromhex("03 02 00 02")))
+                worst_other = max(worst_other, time.monotonic() - asked)
+                time.sleep(max(0.0, started + 0.05 * sent - time.monotonic()))
+        finally:
+            stop.set()
+            thread.join(TIMEOUT)
+        self.assertEqual(holder_errors, [])
+        for i in range(sent):
+            frame = read_frame(waiters[i % 3])
+            self.assertIsNotNone(frame, "the gateway closed the waiting client")
+            self.assertEqual(frame[0], 1000 + i)
+            self.assertEqual(frame[2][:2], b"\x03\x0c", "read %d of the held block: %s" % (i, frame[2].hex(" ")))
+        # The unrelated reads never waited for the hold.
+        self.assertLess(worst_other, 0.5)
 
 
 def rss_kib(pid):
