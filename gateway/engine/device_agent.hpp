@@ -91,6 +91,11 @@ public:
     /// thread, never from inside request(), with the response (normal or exception).
     void request(const protocol::Request& request, ResponseHandler done);
 
+    /// A broadcast write that went out on this device's line: no reply confirms it, so
+    /// what it covers is no longer known to be current (a cached read goes to the
+    /// line), and a motion command makes the motion status stale as a unicast one does.
+    void broadcast_written(const protocol::Request& request);
+
     /// From the line's health callback (LineScheduler) or line state (down = offline).
     void on_health(bool online, TimePoint now);
     void set_notice_callback(NoticeCallback callback);

@@ -37,6 +37,7 @@ public:
     /// DeviceAgent calls it: callbacks may keep the Impl alive a little longer).
     void shut_down();
     void request(const protocol::Request& request, ResponseHandler done);
+    void broadcast_written(const protocol::Request& request);
     void on_health(bool online, TimePoint now);
     void set_notice_callback(NoticeCallback callback) { notice_ = std::move(callback); }
 
@@ -81,6 +82,8 @@ private:
     /// completion, never inside request()) called at once.
     enum class Delivery { posted, now };
     void answer(const OperationPtr& op, protocol::Response response, Delivery delivery = Delivery::posted);
+    /// The motion poll items' registers go to the line until the next motion poll.
+    void mark_motion_status_stale();
     void post_answer(ResponseHandler done, protocol::Response response);
 
     // ---- device_agent.cpp ----

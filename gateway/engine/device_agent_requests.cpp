@@ -117,6 +117,20 @@ void DeviceAgent::Impl::on_step_done(const OperationPtr& op, const Outcome& outc
     submit_step(op);
 }
 
+void DeviceAgent::Impl::broadcast_written(const protocol::Request& request) {
+    if (const std::optional<RequestSpan> span = request_span(request)) {
+        image_.mark_stale(span->table, span->address, span->count);
+    }
+    if (profile_->classify(request).motion) mark_motion_status_stale();
+}
+
+void DeviceAgent::Impl::mark_motion_status_stale() {
+    for (const auto& item : polls_.plan().items()) {
+        if (!item.motion) continue;
+        for (const auto& span : item.fills) image_.mark_stale(span.table, span.address, span.count);
+    }
+}
+
 void DeviceAgent::Impl::answer(const OperationPtr& op, protocol::Response response, Delivery delivery) {
     if (op->answered) {
         return;
@@ -132,10 +146,7 @@ void DeviceAgent::Impl::answer(const OperationPtr& op, protocol::Response respon
         // motion it starts: until the next motion poll refreshes it, a client's read
         // of it goes to the line (a fresh-looking "idle" right after a reset would
         // tell a PLC the homing is already done).
-        for (const auto& item : polls_.plan().items()) {
-            if (!item.motion) continue;
-            for (const auto& span : item.fills) image_.mark_stale(span.table, span.address, span.count);
-        }
+        mark_motion_status_stale();
     }
     if (delivery == Delivery::now && in_request_ == 0 && op->done) {
         // From the line's completion, on the loop: the agent's state is settled, and

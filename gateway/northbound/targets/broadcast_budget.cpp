@@ -37,4 +37,9 @@ bool BroadcastBudget::take(engine::Duration cost, engine::TimePoint now) noexcep
     return true;
 }
 
+void BroadcastBudget::charge(engine::Duration cost, engine::TimePoint now) noexcept {
+    refill(now);
+    balance_ -= cost;
+}
+
 }  // namespace fieldbridge::northbound

@@ -27,6 +27,11 @@ public:
     /// start at @p now; false: over budget, nothing taken.
     [[nodiscard]] bool take(engine::Duration cost, engine::TimePoint now) noexcept;
 
+    /// Takes the cost of a broadcast that goes out whatever the balance (a stop or
+    /// e-stop, rule 4: a fairness budget never holds back a stop). The balance may go
+    /// below zero: the broadcasts after it wait until the stop is paid for.
+    void charge(engine::Duration cost, engine::TimePoint now) noexcept;
+
 private:
     void refill(engine::TimePoint now) noexcept;
 

@@ -1,5 +1,7 @@
 #include "northbound/targets/line_broadcast_target.hpp"
 
+#include <algorithm>
+
 #include <asio/post.hpp>
 
 #include "engine/device_agent_answers.hpp"
@@ -45,10 +47,12 @@ struct LineBroadcastTarget::Shared {
     asio::io_context& io;
     engine::LineWorker* line;
     engine::Duration command_ttl;
+    std::vector<engine::DeviceAgent*> agents;  ///< cleared with `line` when the target goes
 };
 
 /// One broadcast on its way: its steps, the next one, and who to answer.
 struct LineBroadcastTarget::Operation {
+    protocol::Request request;
     std::vector<BroadcastStep> steps;
     std::size_t next = 0;
     std::uint8_t function = 0;
@@ -65,14 +69,19 @@ struct LineBroadcastTarget::Operation {
 
 LineBroadcastTarget::LineBroadcastTarget(asio::io_context& io, engine::LineWorker& line, std::vector<LineUnit> devices,
                                          BroadcastSettings settings)
-    : shared_(std::make_shared<Shared>(Shared{io, &line, settings.command_ttl})),
+    : shared_(std::make_shared<Shared>(Shared{io, &line, settings.command_ttl, {}})),
       devices_(std::move(devices)),
-
       budget_(settings.share_percent) {
-    for (const LineUnit& device : devices_) units_.push_back(device.unit_id);
+    for (const LineUnit& device : devices_) {
+        units_.push_back(device.unit_id);
+        shared_->agents.push_back(device.agent);
+    }
 }
 
-LineBroadcastTarget::~LineBroadcastTarget() { shared_->line = nullptr; }
+LineBroadcastTarget::~LineBroadcastTarget() {
+    shared_->line = nullptr;
+    shared_->agents.clear();
+}
 
 engine::Duration LineBroadcastTarget::line_time(const std::vector<BroadcastStep>& steps) const {
     const engine::LineTimingConfig& timing = shared_->line->config().timing;
@@ -120,10 +129,15 @@ void LineBroadcastTarget::handle(std::uint8_t /*unit*/, protocol::ByteView reque
         refuse(protocol::exception_pdu(op->function, *plan.refusal));
         return;
     }
-    if (!budget_.take(line_time(plan.steps), engine::Clock::now())) {
+    const bool stop = std::all_of(plan.steps.begin(), plan.steps.end(),
+                                  [](const BroadcastStep& step) { return step.urgent; });
+    if (stop) {
+        budget_.charge(line_time(plan.steps), engine::Clock::now());
+    } else if (!budget_.take(line_time(plan.steps), engine::Clock::now())) {
         refuse(protocol::exception_pdu(op->function, GatewayRefusal::busy));
         return;
     }
+    op->request = decoded.value;
     op->steps = std::move(plan.steps);
     op->echo = protocol::encode_response(*echo);
     submit_step(shared_, op);
@@ -149,6 +163,7 @@ void LineBroadcastTarget::submit_step(const std::shared_ptr<Shared>& shared, con
             return;
         }
         if (++op->next == op->steps.size()) {
+            for (engine::DeviceAgent* agent : shared->agents) agent->broadcast_written(op->request);
             op->answer(shared->io, std::move(op->echo));
             return;
         }

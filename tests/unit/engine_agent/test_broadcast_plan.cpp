@@ -88,3 +88,13 @@ TEST_CASE("broadcast budget: at most the share of line time, one second's worth 
     CHECK(budget.take(100ms, t0 + 100s));
     CHECK_FALSE(budget.take(1ms, t0 + 100s));
 }
+
+TEST_CASE("broadcast budget: a stop goes out over budget and the broadcasts after it pay for it") {
+    fn::BroadcastBudget budget(10);  // 100 ms per second
+    const fe::TimePoint t0{};
+    CHECK(budget.take(150ms, t0));       // -50 ms
+    CHECK_FALSE(budget.take(1ms, t0));
+    budget.charge(50ms, t0);             // the stop: -100 ms
+    CHECK_FALSE(budget.take(1ms, t0 + 900ms));  // refilled 90 ms: -10 ms
+    CHECK(budget.take(1ms, t0 + 1100ms));       // +10 ms
+}
