@@ -99,8 +99,6 @@ bool has_register_pairs(DeviceType type) noexcept {
     return type == DeviceType::excd203mb || type == DeviceType::modbus;
 }
 
-bool speaks_modbus(DeviceType type) noexcept { return type != DeviceType::wtec_ascii; }
-
 namespace {
 
 template <class T>

@@ -65,8 +65,6 @@ enum class MqttVersion { v3_1_1, v5 };
 [[nodiscard]] std::uint8_t broadcast_address(DeviceType type) noexcept;
 /// Types with 32-bit values spread over two registers, where `word_order` applies.
 [[nodiscard]] bool has_register_pairs(DeviceType type) noexcept;
-/// Every type but wtec-ascii talks Modbus-RTU on the line.
-[[nodiscard]] bool speaks_modbus(DeviceType type) noexcept;
 
 struct Backoff {
     milliseconds initial;
