@@ -440,9 +440,10 @@ private:
             ++reopens_;
             log_(LogLevel::info, "line " + config_.name + ": " + path() + " reopened after " +
                                      std::to_string(open_attempts_) +
-                                     (open_attempts_ == 1 ? " attempt" : " attempts"));
+                                     (open_attempts_ == 1 ? " attempt" : " attempts") + ", " +
+                                     to_string(port_.low_latency()));
         } else {
-            log_(LogLevel::info, "line " + config_.name + ": " + path() + " open");
+            log_(LogLevel::info, "line " + config_.name + ": " + path() + " open, " + to_string(port_.low_latency()));
         }
         down_ = false;
         open_attempts_ = 0;

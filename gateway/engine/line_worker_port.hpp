@@ -34,6 +34,7 @@ public:
     void close() noexcept;
     [[nodiscard]] bool is_open() const noexcept;
     [[nodiscard]] const SerialSettings& settings() const noexcept { return port_->settings(); }
+    [[nodiscard]] LowLatency low_latency() const noexcept { return port_->low_latency(); }
 
     /// What the driver accepts now (0: it would block). Throws SerialPortError.
     [[nodiscard]] std::size_t write_some(protocol::ByteView bytes);

@@ -43,7 +43,8 @@ void PosixSerialPort::ContextDeleter::operator()(_modbus* ctx) const noexcept {
     modbus_free(ctx);
 }
 
-PosixSerialPort::PosixSerialPort(SerialSettings settings) : settings_(std::move(settings)) {}
+PosixSerialPort::PosixSerialPort(SerialSettings settings, SerialIoctls ioctls)
+    : settings_(std::move(settings)), ioctls_(std::move(ioctls)) {}
 
 PosixSerialPort::~PosixSerialPort() { close(); }
 
@@ -78,6 +79,8 @@ void PosixSerialPort::open() {
     tio.c_cc[VTIME] = 0;
     if (::tcsetattr(fd_, TCSANOW, &tio) == -1) fail("cannot set the terminal read mode", errno);
     if (settings_.rs485) apply_rs485();
+    // Not a reason to refuse the port: the line works, only slower on some adapters.
+    low_latency_ = request_low_latency(fd_, ioctls_);
     discard_input();
 }
 

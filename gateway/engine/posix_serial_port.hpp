@@ -15,7 +15,8 @@ namespace fieldbridge::engine {
 
 class PosixSerialPort final : public SerialPort {
 public:
-    explicit PosixSerialPort(SerialSettings settings);
+    /// @p ioctls: the driver calls of the low-latency request (a seam for tests).
+    explicit PosixSerialPort(SerialSettings settings, SerialIoctls ioctls = SerialIoctls::system());
     ~PosixSerialPort() override;
 
     void open() override;
@@ -26,12 +27,15 @@ public:
     [[nodiscard]] std::size_t read_some(std::span<std::uint8_t> buffer) override;
     void discard_input() noexcept override;
     [[nodiscard]] const SerialSettings& settings() const noexcept override { return settings_; }
+    [[nodiscard]] LowLatency low_latency() const noexcept override { return low_latency_; }
 
 private:
     void apply_rs485();
     [[noreturn]] void fail(const char* what, int error);
 
     SerialSettings settings_;
+    SerialIoctls ioctls_;
+    LowLatency low_latency_;
     struct ContextDeleter {
         void operator()(_modbus* ctx) const noexcept;
     };

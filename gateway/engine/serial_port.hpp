@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/serial_low_latency.hpp"
 #include "protocol/bytes.hpp"
 
 namespace fieldbridge::engine {
@@ -57,6 +58,8 @@ public:
     /// Drops whatever is in the driver's input buffer (resynchronisation).
     virtual void discard_input() noexcept = 0;
     [[nodiscard]] virtual const SerialSettings& settings() const noexcept = 0;
+    /// What the driver said to the low-latency request of the last open() (for the log).
+    [[nodiscard]] virtual LowLatency low_latency() const noexcept { return {}; }
 };
 
 }  // namespace fieldbridge::engine

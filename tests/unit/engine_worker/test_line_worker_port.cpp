@@ -81,6 +81,8 @@ TEST_CASE("worker: a port missing at start is retried until it appears") {
     PtyDevice device(io, link);
     REQUIRE(run_until(io, [&] { return worker.line_up(); }, 1000ms));
     CHECK(worker.reopens() == 1);
+    // The open is logged with what the driver said to the low-latency request.
+    CHECK(logs.contains(fe::LogLevel::info, "low latency: not supported by the driver"));
     worker.submit(tagged(read_tx(1, Priority::poll), recorder, "poll"));
     REQUIRE(run_until(io, [&] { return recorder.total() == 1; }));
     CHECK(recorder.status("poll") == OutcomeStatus::ok);
