@@ -123,6 +123,11 @@ check "systemd-analyze verify on the installed units: silent" \
   silent systemd-analyze verify /lib/systemd/system/fieldbridge.*
 check "the service is installed but not enabled" \
   test ! -e /etc/systemd/system/multi-user.target.wants/fieldbridge.service
+# What a running systemd would do, read from the maintainer scripts dh_installsystemd wrote.
+check "postinst: starts or restarts the unit through deb-systemd-invoke (no disabled unit is started)" \
+  contains "$(cat /var/lib/dpkg/info/fieldbridge.postinst)" "deb-systemd-invoke \\\$_dh_action 'fieldbridge.service'"
+check "prerm: stops the service on remove" \
+  contains "$(cat /var/lib/dpkg/info/fieldbridge.prerm)" "deb-systemd-invoke stop 'fieldbridge.service'"
 for page in /usr/share/man/man8/fieldbridge.8.gz /usr/share/man/man5/fieldbridge.yaml.5.gz \
             /usr/share/man/man1/fieldbridge-sim.1.gz; do
   check "man --warnings: $(basename "$page")" \
