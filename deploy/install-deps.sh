@@ -14,6 +14,9 @@ packages=(
   # test and demo tools
   socat mosquitto mosquitto-clients mbpoll python3 python3-pymodbus
   python3-serial-asyncio procps  # pymodbus.client imports serial_asyncio (a Recommends)
+  # Debian packages (deploy/build-deb) and their test (tests/package/test-package.sh):
+  # systemd for systemd-analyze and systemd-sysusers, man-db for man --warnings
+  debhelper dpkg-dev lintian man-db systemd
 )
 
 missing=()

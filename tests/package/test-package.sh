@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# The Debian packages end to end, on this machine (Debian 12, as root or with sudo):
+# builds fieldbridge and fieldbridge-sim with deploy/build-deb, installs them with apt,
+# checks the service user, the files, the conffile, the configuration check, the units
+# (systemd-analyze verify), the man pages and lintian, then edits the conffile, removes
+# the packages (the edit stays) and purges them (it goes).
+#
+# systemd need not be PID 1 (CI runs in a container): the maintainer scripts create the
+# user with systemd-sysusers, which works without a running systemd, and skip starting
+# units; systemd-analyze verify reads the installed unit files offline. What needs a
+# running systemd (systemctl start) is not tested here.
+#
+# The machine is left as it was found: an exit trap purges both packages and deletes
+# the user and group if this script's install created them. It refuses to run when
+# either package is already installed.
+#
+# Usage: tests/package/test-package.sh
+#   FIELDBRIDGE_DEB_DIR        where the packages are built (default build-deb/)
+#   FIELDBRIDGE_DEB_PREBUILT=1 test the packages already in that directory, no build
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+out="${FIELDBRIDGE_DEB_DIR:-$here/build-deb}"
+export FIELDBRIDGE_DEB_DIR="$out"
+
+SUDO=()
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO=(sudo); else
+    echo "test-package: installs packages with apt-get: run as root or install sudo" >&2
+    exit 1
+  fi
+fi
+as_root() { "${SUDO[@]}" "$@"; }
+
+started=$SECONDS
+installed() {  # installed PACKAGE: dpkg knows it in any state but not-installed (config-files too)
+  local status
+  status="$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" || return 1
+  [ -n "$status" ] && [ "${status##* }" != not-installed ]
+}
+for p in fieldbridge fieldbridge-sim; do
+  if installed "$p"; then
+    echo "test-package: $p is already installed (or its configuration is left); this test installs and" \
+         "purges it. Purge it first: apt-get purge $p" >&2
+    exit 1
+  fi
+done
+user_existed=0; getent passwd fieldbridge >/dev/null && user_existed=1
+group_existed=0; getent group fieldbridge >/dev/null && group_existed=1
+
+cleanup() {
+  local rc=$?
+  for p in fieldbridge-sim fieldbridge; do
+    if installed "$p"; then as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "$p" >/dev/null || rc=1; fi
+  done
+  # Debian leaves system users in place on purge; this test removes the one it made.
+  if [ "$user_existed" = 0 ] && getent passwd fieldbridge >/dev/null; then as_root userdel fieldbridge || rc=1; fi
+  if [ "$group_existed" = 0 ] && getent group fieldbridge >/dev/null; then as_root groupdel fieldbridge || rc=1; fi
+  exit $rc
+}
+trap cleanup EXIT
+
+if [ "${FIELDBRIDGE_DEB_PREBUILT:-0}" != 1 ]; then
+  mkdir -p "$out"
+  build_started=$SECONDS
+  "$here/deploy/build-deb" > "$out/build-deb.log" 2>&1 || { tail -50 "$out/build-deb.log" >&2; echo "test-package: deploy/build-deb failed (log: $out/build-deb.log)" >&2; exit 1; }
+  echo "test-package: deploy/build-deb took $((SECONDS - build_started)) s (log: $out/build-deb.log)"
+fi
+version="$(sed -n 's/^project(fieldbridge VERSION \([0-9][0-9.]*\).*/\1/p' "$here/CMakeLists.txt")"
+arch="$(dpkg --print-architecture)"
+deb="$out/fieldbridge_${version}_${arch}.deb"
+sim_deb="$out/fieldbridge-sim_${version}_${arch}.deb"
+
+passed=0; failed=0
+check() {  # check DESCRIPTION COMMAND...: run it, count it, show its output when it fails
+  local description="$1"; shift
+  local output
+  if output="$("$@" 2>&1)"; then
+    passed=$((passed + 1)); echo "ok   $description"
+  else
+    failed=$((failed + 1)); echo "FAIL $description"; printf '%s\n' "$output" | sed 's/^/     /'
+  fi
+}
+silent() {  # silent COMMAND...: succeeds when COMMAND exits 0 and prints nothing
+  local output
+  output="$("$@" 2>&1)" || { printf '%s\n' "$output"; return 1; }
+  [ -z "$output" ] || { printf 'unexpected output:\n%s\n' "$output"; return 1; }
+}
+contains() {  # contains TEXT PATTERN: grep -E PATTERN in TEXT, TEXT shown when it is not there
+  grep -Eq -- "$2" <<<"$1" || { printf 'no /%s/ in:\n%s\n' "$2" "$1"; return 1; }
+}
+lacks() { ! grep -Eq -- "$2" <<<"$1" || { printf '/%s/ found in:\n%s\n' "$2" "$1"; return 1; }; }
+
+check "both packages built: $(basename "$deb") $(basename "$sim_deb")" test -f "$deb" -a -f "$sim_deb"
+check "lintian: no error or warning" lintian --fail-on error,warning --display-info "$deb" "$sim_deb"
+check "dependencies computed by dpkg-shlibdeps (libmodbus, paho, yaml-cpp, libsystemd)" \
+  contains "$(dpkg-deb -f "$deb" Depends)" 'libmodbus5.*libpaho-mqttpp3-1.*libsystemd0.*libyaml-cpp0'
+
+check "apt-get install ./fieldbridge_*.deb ./fieldbridge-sim_*.deb" \
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$deb" "$sim_deb"
+
+check "user fieldbridge: system user, no login shell" \
+  contains "$(getent passwd fieldbridge)" '^fieldbridge:x:[0-9]{1,3}:[0-9]+:.*:(/usr/sbin/nologin|/sbin/nologin)$'
+check "user fieldbridge: groups fieldbridge and dialout" contains " $(id -nG fieldbridge) " ' fieldbridge .*dialout |.* dialout .*fieldbridge '
+for f in /usr/bin/fieldbridge /usr/bin/fieldbridge-sim /lib/systemd/system/fieldbridge.service \
+         /usr/lib/sysusers.d/fieldbridge.conf /etc/fieldbridge/fieldbridge.yaml \
+         /usr/share/man/man8/fieldbridge.8.gz /usr/share/man/man5/fieldbridge.yaml.5.gz \
+         /usr/share/man/man1/fieldbridge-sim.1.gz /usr/share/doc/fieldbridge/copyright; do
+  check "installed: $f" test -f "$f"
+done
+if [ -f "$here/deploy/fieldbridge.socket" ]; then
+  check "installed: /lib/systemd/system/fieldbridge.socket" test -f /lib/systemd/system/fieldbridge.socket
+fi
+check "docs: the operations guide service.md in /usr/share/doc/fieldbridge" \
+  contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/service\.md'
+check "conffile: /etc/fieldbridge/fieldbridge.yaml" \
+  contains "$(dpkg-query -W -f='${Conffiles}' fieldbridge)" '^ /etc/fieldbridge/fieldbridge\.yaml [0-9a-f]{32}$'
+check "conffile is the commented example" cmp /etc/fieldbridge/fieldbridge.yaml "$here/config/fieldbridge.example.yaml"
+check "fieldbridge --version" contains "$(fieldbridge --version)" "^fieldbridge $version\$"
+check "fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml (as user fieldbridge): exit 0" \
+  as_root runuser -u fieldbridge -- /usr/bin/fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml
+check "fieldbridge-sim --help" /usr/bin/fieldbridge-sim --help
+check "systemd-analyze verify on the installed units: silent" \
+  silent systemd-analyze verify /lib/systemd/system/fieldbridge.*
+check "the service is installed but not enabled" \
+  test ! -e /etc/systemd/system/multi-user.target.wants/fieldbridge.service
+# What a running systemd would do, read from the maintainer scripts dh_installsystemd wrote.
+check "postinst: starts or restarts the unit through deb-systemd-invoke (no disabled unit is started)" \
+  contains "$(cat /var/lib/dpkg/info/fieldbridge.postinst)" "deb-systemd-invoke \\\$_dh_action 'fieldbridge.service'"
+check "prerm: stops the service on remove" \
+  contains "$(cat /var/lib/dpkg/info/fieldbridge.prerm)" "deb-systemd-invoke stop 'fieldbridge.service'"
+for page in /usr/share/man/man8/fieldbridge.8.gz /usr/share/man/man5/fieldbridge.yaml.5.gz \
+            /usr/share/man/man1/fieldbridge-sim.1.gz; do
+  check "man --warnings: $(basename "$page")" \
+    silent env LC_ALL=C.UTF-8 MANWIDTH=80 sh -c 'man --warnings -E UTF-8 -l "$1" >/dev/null' man "$page"
+done
+
+edit="# edited by tests/package/test-package.sh"
+as_root sh -c "echo '$edit' >> /etc/fieldbridge/fieldbridge.yaml"
+check "apt-get remove fieldbridge fieldbridge-sim" \
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get remove -y -qq fieldbridge fieldbridge-sim
+check "after remove: /usr/bin/fieldbridge is gone" test ! -e /usr/bin/fieldbridge
+check "after remove: the edited conffile stays" grep -qxF "$edit" /etc/fieldbridge/fieldbridge.yaml
+check "after remove: fieldbridge is in state config-files" \
+  contains "$(dpkg-query -W -f='${Status}' fieldbridge)" 'deinstall ok config-files'
+check "apt-get purge fieldbridge" as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq fieldbridge
+check "after purge: /etc/fieldbridge is gone" test ! -e /etc/fieldbridge
+check "after purge: no unit left" test ! -e /lib/systemd/system/fieldbridge.service
+
+echo "test-package: $((SECONDS - started)) s in all"
+echo "package: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
