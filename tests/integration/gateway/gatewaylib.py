@@ -354,9 +354,12 @@ class CellTestCase(unittest.TestCase):
     # -- starting --------------------------------------------------------------------
 
     def start_cell(self, r6=False, mqtt=False, extra_devices_a="", extra_devices_b="", extra_lines="",
-                   rules="", max_connections=64, sim_line_b="wtec-rtu@1", sim_extra=(), before_gateway=None):
+                   rules="", max_connections=64, sim_line_b="wtec-rtu@1", sim_extra=(), before_gateway=None,
+                   launcher=None, wait_ready=True):
         """Simulator, broker (mqtt=True), before_gateway() if given, gateway; returns
-        when the gateway is ready."""
+        when the gateway is ready (wait_ready=False: as soon as it was started).
+        launcher() returns the command line put before the gateway's own (e.g.
+        systemd-socket-activate), called once the ports are chosen."""
         self.tcp_port = free_port()
         self.r6_port = free_port() if r6 else None
         args = ["--bus", self.path("line-a") + ":hiwin-xeg@2,excd203mb@3,wtec-ascii@5",
@@ -379,12 +382,16 @@ class CellTestCase(unittest.TestCase):
         self.config_path = self.path("gateway.yaml")
         with open(self.config_path, "w", encoding="utf-8") as f:
             f.write(config)
-        self.start_gateway()
+        self.start_gateway(launcher() if launcher else (), wait_ready)
 
-    def start_gateway(self):
-        self.gateway = Process("fieldbridge", [GATEWAY, "--config", self.config_path],
+    def start_gateway(self, launcher=(), wait_ready=True):
+        self.gateway = Process("fieldbridge", list(launcher) + [GATEWAY, "--config", self.config_path],
                                self.path("gateway.log"), env=environment())
         self.processes.append(self.gateway)
+        if wait_ready:
+            self.wait_ready()
+
+    def wait_ready(self):
         if self.gateway.wait_line(lambda line: "ready:" in line, START_TIMEOUT) is None:
             self.fail("fieldbridge did not log 'ready:' within %.0f s:\n%s"
                       % (START_TIMEOUT, self.gateway.text()))
