@@ -299,7 +299,16 @@ mqtt:
 class CellTestCase(unittest.TestCase):
     """A simulated cell: fieldbridge-sim with line-a (XEG @2 unit 1, EXCD203MB @3 unit 2,
     WTEC ASCII @5 unit 3, broadcast unit 100) and line-b (WTEC RTU @1 unit 4), the
-    gateway in front of it, optionally the R6 (unit 50) and a broker."""
+    gateway in front of it, optionally the R6 (unit 50) and a broker.
+
+    A test case may set, before start_cell(): mqtt_config (the gateway's `mqtt:`
+    section, formatted with mqtt_port), broker_listener (mosquitto's listener lines
+    after `listener PORT 127.0.0.1`, e.g. TLS files) and mqtt_client_args (added to
+    every mosquitto_sub / mosquitto_pub, e.g. --cafile)."""
+
+    mqtt_config = MQTT_CONFIG
+    broker_listener = "allow_anonymous true\n"
+    mqtt_client_args = ()
 
     def setUp(self):
         if PYMODBUS_ERROR is not None:
@@ -378,7 +387,7 @@ class CellTestCase(unittest.TestCase):
             extra_devices_a=extra_devices_a, extra_devices_b=extra_devices_b, extra_lines=extra_lines,
             rules=rules,
             upstreams=UPSTREAM_CONFIG.format(r6_port=self.r6_port) if r6 else "",
-            mqtt=MQTT_CONFIG.format(mqtt_port=self.mqtt_port) if mqtt else "")
+            mqtt=self.mqtt_config.format(mqtt_port=self.mqtt_port) if mqtt else "")
         self.config_path = self.path("gateway.yaml")
         with open(self.config_path, "w", encoding="utf-8") as f:
             f.write(config)
@@ -399,7 +408,7 @@ class CellTestCase(unittest.TestCase):
     def start_broker(self):
         conf = self.path("mosquitto.conf")
         with open(conf, "w", encoding="utf-8") as f:
-            f.write("listener %d 127.0.0.1\nallow_anonymous true\npersistence false\n" % self.mqtt_port)
+            f.write("listener %d 127.0.0.1\n%spersistence false\n" % (self.mqtt_port, self.broker_listener))
         self.broker = Process("mosquitto", ["mosquitto", "-c", conf], self.path("mosquitto.log"))
         self.processes.append(self.broker)
         if not wait_port(self.mqtt_port, START_TIMEOUT, self.broker.running):
@@ -413,7 +422,7 @@ class CellTestCase(unittest.TestCase):
 
     def subscribe(self, *topics):
         command = ["mosquitto_sub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
-                   "-F", "%r %t %p"]
+                   "-F", "%r %t %p"] + list(self.mqtt_client_args)
         for topic in topics:
             command += ["-t", topic]
         sub = Subscriber("mosquitto_sub", command, self.path("sub-%d.log" % len(self.processes)),
@@ -426,7 +435,7 @@ class CellTestCase(unittest.TestCase):
 
     def publish(self, topic, payload, retain=False):
         command = ["mosquitto_pub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
-                   "-t", topic, "-m", payload]
+                   "-t", topic, "-m", payload] + list(self.mqtt_client_args)
         if retain:
             command.append("-r")
         done = subprocess.run(command, capture_output=True, text=True, timeout=IO_TIMEOUT)

@@ -73,6 +73,16 @@ class MqttCell(gatewaylib.CellTestCase):
             self.assertFalse(result["ok"], result)
         return result
 
+    def assert_will_on_sigkill(self):
+        """SIGKILL the gateway: the broker publishes its will, `offline`, retained."""
+        mark = self.sub.mark()
+        self.gateway.signal(signal.SIGKILL)
+        self.gateway.wait_exit()
+        self.assertEqual(self.sub.wait_message(topic("status"), lambda p: p == "offline", TIMEOUT, mark),
+                         (False, "offline"))
+        late = self.subscribe(topic("status"))
+        self.assertEqual(late.wait_message(topic("status"), timeout=TIMEOUT), (True, "offline"))
+
     def wait_state(self, device, check, timeout=MOTION_TIMEOUT, start=0):
         found = self.sub.wait_message(topic(device, "state"), json_predicate(check), timeout, start)
         self.assertIsNotNone(found, "no matching state of %s" % device)
@@ -313,13 +323,7 @@ class LastWill(MqttCell):
     def test_sigkill_publishes_the_will(self):
         self.start()
         self.assertIsNotNone(self.sub.wait_message(topic("status"), lambda p: p == "online", TIMEOUT))
-        mark = self.sub.mark()
-        self.gateway.signal(signal.SIGKILL)
-        self.gateway.wait_exit()
-        self.assertEqual(self.sub.wait_message(topic("status"), lambda p: p == "offline", TIMEOUT, mark),
-                         (False, "offline"))
-        late = self.subscribe(topic("status"))
-        self.assertEqual(late.wait_message(topic("status"), timeout=TIMEOUT), (True, "offline"))
+        self.assert_will_on_sigkill()
 
     def test_sigterm_publishes_offline(self):
         self.start()
