@@ -303,11 +303,14 @@ class CellTestCase(unittest.TestCase):
 
     A test case may set, before start_cell(): mqtt_config (the gateway's `mqtt:`
     section, formatted with mqtt_port), broker_listener (mosquitto's listener lines
-    after `listener PORT 127.0.0.1`, e.g. TLS files) and mqtt_client_args (added to
-    every mosquitto_sub / mosquitto_pub, e.g. --cafile)."""
+    after `listener PORT 127.0.0.1`, e.g. TLS files), broker_persistence (True: the
+    broker keeps retained messages and persistent sessions across a stop_broker() /
+    start_broker()) and mqtt_client_args (added to every mosquitto_sub /
+    mosquitto_pub, e.g. --cafile)."""
 
     mqtt_config = MQTT_CONFIG
     broker_listener = "allow_anonymous true\n"
+    broker_persistence = False
     mqtt_client_args = ()
 
     def setUp(self):
@@ -408,11 +411,22 @@ class CellTestCase(unittest.TestCase):
     def start_broker(self):
         conf = self.path("mosquitto.conf")
         with open(conf, "w", encoding="utf-8") as f:
-            f.write("listener %d 127.0.0.1\n%spersistence false\n" % (self.mqtt_port, self.broker_listener))
+            f.write("listener %d 127.0.0.1\n%s%s" % (self.mqtt_port, self.broker_listener, self._persistence()))
         self.broker = Process("mosquitto", ["mosquitto", "-c", conf], self.path("mosquitto.log"))
         self.processes.append(self.broker)
         if not wait_port(self.mqtt_port, START_TIMEOUT, self.broker.running):
             self.fail("mosquitto did not listen on %d:\n%s" % (self.mqtt_port, _read(self.broker.log_path)))
+
+    def _persistence(self):
+        if not self.broker_persistence:
+            return "persistence false\n"
+        # mosquitto started as root runs as user mosquitto: it must write there.
+        directory = self.path("broker-db")
+        if not os.path.isdir(directory):
+            os.chmod(self.tmp, 0o711)
+            os.mkdir(directory)
+            os.chmod(directory, 0o777)
+        return "persistence true\npersistence_location %s/\n" % directory
 
     def stop_broker(self):
         self.broker.signal(signal.SIGTERM)
@@ -420,9 +434,14 @@ class CellTestCase(unittest.TestCase):
         self.processes.remove(self.broker)
         self.broker.kill()
 
-    def subscribe(self, *topics):
+    def subscribe(self, *topics, session=None):
+        """mosquitto_sub on topics; session: a client id for a persistent session (with
+        broker_persistence it gets, once it has reconnected by itself, what was
+        published while the broker was restarting)."""
         command = ["mosquitto_sub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
                    "-F", "%r %t %p"] + list(self.mqtt_client_args)
+        if session is not None:
+            command += ["-c", "-i", session]
         for topic in topics:
             command += ["-t", topic]
         sub = Subscriber("mosquitto_sub", command, self.path("sub-%d.log" % len(self.processes)),
