@@ -27,11 +27,9 @@ set(_fb_config_dir "${CMAKE_INSTALL_FULL_SYSCONFDIR}/fieldbridge")
 
 install(FILES "${_fb_deploy}/fieldbridge.service" DESTINATION "${FIELDBRIDGE_SYSTEMD_UNIT_DIR}"
         COMPONENT daemon)
-# Socket activation of port 502, when the unit exists.
-if(EXISTS "${_fb_deploy}/fieldbridge.socket")
-  install(FILES "${_fb_deploy}/fieldbridge.socket" DESTINATION "${FIELDBRIDGE_SYSTEMD_UNIT_DIR}"
-          COMPONENT daemon)
-endif()
+# Socket activation of port 502 (docs/service.md, "Socket activation").
+install(FILES "${_fb_deploy}/fieldbridge.socket" DESTINATION "${FIELDBRIDGE_SYSTEMD_UNIT_DIR}"
+        COMPONENT daemon)
 install(FILES "${_fb_deploy}/fieldbridge.sysusers" DESTINATION "${FIELDBRIDGE_SYSUSERS_DIR}"
         RENAME fieldbridge.conf COMPONENT daemon)
 

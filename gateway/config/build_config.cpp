@@ -203,6 +203,7 @@ void set(T& target, const Field<T>& field) {
     mqtt.max_queued_commands = narrow<std::size_t>(raw.max_queued_commands, mqtt.max_queued_commands);
     mqtt.max_queued_command_bytes = narrow<std::size_t>(raw.max_queued_command_bytes, mqtt.max_queued_command_bytes);
     mqtt.outbox_max_bytes = narrow<std::size_t>(raw.outbox_max_bytes, mqtt.outbox_max_bytes);
+    mqtt.outbox_max_messages = narrow<std::size_t>(raw.outbox_max_messages, mqtt.outbox_max_messages);
     return mqtt;
 }
 

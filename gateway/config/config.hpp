@@ -318,6 +318,10 @@ struct MqttConfig {
     /// Publications waiting for the broker, in payload + topic bytes.
     std::size_t outbox_max_bytes = 4 * 1024 * 1024;
     static constexpr Range<std::int64_t> outbox_max_bytes_range{64 * 1024, 256 * 1024 * 1024};
+    /// The same bound in messages: what a broker outage may keep of alarm events and
+    /// command results (retained state takes one place per topic).
+    std::size_t outbox_max_messages = 512;
+    static constexpr Range<std::int64_t> outbox_max_messages_range{16, 1000000};
     static constexpr std::size_t max_client_id_length = 128;
     static constexpr std::size_t max_prefix_length = 256;
 

@@ -208,6 +208,7 @@ struct RawMqtt : RawNode {
     Field<std::int64_t> max_queued_commands;
     Field<std::int64_t> max_queued_command_bytes;
     Field<std::int64_t> outbox_max_bytes;
+    Field<std::int64_t> outbox_max_messages;
 };
 
 struct RawMetricsHttp : RawNode {

@@ -123,7 +123,8 @@ RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
                         {"enabled", "uri", "client_id", "username", "password", "password_file", "tls", "qos",
                          "keep_alive", "clean_session", "version", "prefix", "heartbeat", "min_interval", "deadband",
                          "diag_period", "reconnect_backoff", "max_command_bytes", "max_command_id_length",
-                         "max_queued_commands", "max_queued_command_bytes", "outbox_max_bytes"},
+                         "max_queued_commands", "max_queued_command_bytes", "outbox_max_bytes",
+                         "outbox_max_messages"},
                         sink);
     RawMqtt raw;
     map.fill(raw);
@@ -149,6 +150,7 @@ RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
     raw.max_queued_commands = read_int(map, "max_queued_commands");
     raw.max_queued_command_bytes = read_int(map, "max_queued_command_bytes");
     raw.outbox_max_bytes = read_int(map, "outbox_max_bytes");
+    raw.outbox_max_messages = read_int(map, "outbox_max_messages");
     return raw;
 }
 

@@ -162,6 +162,7 @@ void validate_mqtt(const RawMqtt& mqtt, const std::filesystem::path& base_dir, D
     check_range(sink, mqtt.max_queued_commands, MqttConfig::max_queued_commands_range);
     check_range(sink, mqtt.max_queued_command_bytes, MqttConfig::max_queued_command_bytes_range);
     check_range(sink, mqtt.outbox_max_bytes, MqttConfig::outbox_max_bytes_range);
+    check_range(sink, mqtt.outbox_max_messages, MqttConfig::outbox_max_messages_range);
     check_backoff(sink, mqtt.reconnect_backoff, MqttConfig{}.reconnect_backoff);
 }
 

@@ -22,6 +22,7 @@
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_service_manager.hpp"
+#include "daemon/systemd_sockets.hpp"
 #include "scan/scan_command.hpp"
 
 #ifndef FIELDBRIDGE_VERSION
@@ -58,6 +59,15 @@ using namespace fieldbridge;
         return daemon::exit_config_error;
     }
 
+    // Socket activation: listeners passed by systemd replace binding (docs/service.md).
+    std::vector<northbound::modbus_tcp::InheritedListener> inherited;
+    try {
+        inherited = daemon::match_passed_sockets(initial->modbus_tcp.listen, daemon::take_systemd_sockets());
+    } catch (const daemon::SocketActivationError& error) {
+        logger->error("cannot start: {}", error.what());
+        return daemon::exit_config_error;
+    }
+
     daemon::SystemdServiceManager manager(logger);
     daemon::DaemonOptions options;
     options.config_file = command.config_file;
@@ -67,7 +77,7 @@ using namespace fieldbridge;
     daemon::EngineComponent engine(gateway.context(), logger);
     gateway.add_component(engine);
     gateway.add_status([&engine] { return engine.status(); });
-    daemon::ModbusTcpComponent modbus_tcp(gateway.context(), logger, engine);
+    daemon::ModbusTcpComponent modbus_tcp(gateway.context(), logger, engine, std::move(inherited));
     gateway.add_component(modbus_tcp);
     gateway.add_status([&modbus_tcp] { return modbus_tcp.status(); });
     // MQTT last among the components: stopped first, so `offline` goes out while the

@@ -1,5 +1,7 @@
 #include "daemon/modbus_tcp_component.hpp"
 
+#include <unistd.h>
+
 namespace fieldbridge::daemon {
 
 namespace {
@@ -12,8 +14,9 @@ std::shared_ptr<const config::ModbusTcpConfig> tcp_config(const std::shared_ptr<
 }  // namespace
 
 ModbusTcpComponent::ModbusTcpComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger,
-                                       EngineComponent& engine)
-    : io_(io), logger_(std::move(logger)), engine_(engine) {
+                                       EngineComponent& engine,
+                                       std::vector<northbound::modbus_tcp::InheritedListener> inherited)
+    : io_(io), logger_(std::move(logger)), engine_(engine), inherited_(std::move(inherited)) {
     engine_.on_change([this](engine::Engine* current) {
         if (server_) rebuild_routes(current);
     });
@@ -22,6 +25,7 @@ ModbusTcpComponent::ModbusTcpComponent(asio::io_context& io, std::shared_ptr<spd
 ModbusTcpComponent::~ModbusTcpComponent() {
     if (server_) server_->stop();
     stop_upstreams();
+    for (const auto& listener : inherited_) ::close(listener.fd);
 }
 
 void ModbusTcpComponent::build_upstreams() {
@@ -71,6 +75,8 @@ void ModbusTcpComponent::start(StartContext& context) {
     config_ = context.config();
     server_ = std::make_unique<northbound::modbus_tcp::ModbusTcpServer>(io_, tcp_config(config_),
                                                                          engine_log_sink(logger_));
+    for (auto& listener : inherited_) server_->adopt(std::move(listener));
+    inherited_.clear();
     build_upstreams();
     rebuild_routes(engine_.engine());
     // Binding is synchronous: when start() returns the listeners accept, so READY

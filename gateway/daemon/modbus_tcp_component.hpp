@@ -23,7 +23,10 @@ namespace fieldbridge::daemon {
 class ModbusTcpComponent final : public Component {
 public:
     /// @p engine must be registered before this component (it starts first).
-    ModbusTcpComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger, EngineComponent& engine);
+    /// @p inherited: sockets passed by systemd for modbus_tcp.listen entries
+    /// (match_passed_sockets()); owned from here on, the server takes them at start().
+    ModbusTcpComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger, EngineComponent& engine,
+                       std::vector<northbound::modbus_tcp::InheritedListener> inherited = {});
     ~ModbusTcpComponent() override;
 
     [[nodiscard]] std::string name() const override { return "Modbus TCP server"; }
@@ -57,6 +60,7 @@ private:
     std::vector<std::unique_ptr<northbound::upstream::UpstreamTarget>> upstreams_;
     std::vector<std::unique_ptr<northbound::UnitTarget>> serial_targets_;
     std::vector<std::function<void()>> upstreams_closing_;
+    std::vector<northbound::modbus_tcp::InheritedListener> inherited_;  ///< until start() hands them over
 };
 
 }  // namespace fieldbridge::daemon

@@ -107,9 +107,7 @@ for f in /usr/bin/fieldbridge /usr/bin/fieldbridge-sim /lib/systemd/system/field
          /usr/share/man/man1/fieldbridge-sim.1.gz /usr/share/doc/fieldbridge/copyright; do
   check "installed: $f" test -f "$f"
 done
-if [ -f "$here/deploy/fieldbridge.socket" ]; then
-  check "installed: /lib/systemd/system/fieldbridge.socket" test -f /lib/systemd/system/fieldbridge.socket
-fi
+check "installed: /lib/systemd/system/fieldbridge.socket" test -f /lib/systemd/system/fieldbridge.socket
 check "docs: the operations guide service.md in /usr/share/doc/fieldbridge" \
   contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/service\.md'
 check "conffile: /etc/fieldbridge/fieldbridge.yaml" \

@@ -2,7 +2,11 @@
 
 #include <asio/ip/v6_only.hpp>
 #include <cerrno>
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/socket.h>
+#include <system_error>
+#include <unistd.h>
 
 #include "northbound/modbus_tcp/modbus_tcp_error.hpp"
 
@@ -19,9 +23,10 @@ std::string listen_advice(const asio::error_code& error, const config::ListenAdd
     }
     if (error == asio::error::access_denied || error.value() == EACCES || error.value() == EPERM) {
         if (address.port < first_unprivileged_port) {
-            return fmt::format("port {} is privileged: run with CAP_NET_BIND_SERVICE (the systemd unit sets "
-                               "AmbientCapabilities=CAP_NET_BIND_SERVICE) or listen on a port from 1024 up",
-                               address.port);
+            return fmt::format("port {} is privileged: start fieldbridge from its socket unit (fieldbridge.socket "
+                               "with ListenStream={}), run it with CAP_NET_BIND_SERVICE, or listen on a port from "
+                               "1024 up (docs/service.md, \"Socket activation\")",
+                               address.port, address.to_string());
         }
         return "the system refused the bind (a security policy?); check the journal for an LSM denial";
     }
@@ -63,6 +68,32 @@ asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::L
     if (error) {
         throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {} ({} failed: {}): {}", address.to_string(),
                                          step, error.message(), listen_advice(error, address)));
+    }
+    return acceptor;
+}
+
+asio::ip::tcp::acceptor duplicate_listen_socket(asio::io_context& io, int fd, const config::ListenAddress& address) {
+    sockaddr_storage local{};
+    socklen_t length = sizeof local;
+    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &length) != 0 ||
+        (local.ss_family != AF_INET && local.ss_family != AF_INET6)) {
+        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {}: the socket passed for it (fd {}) is not an "
+                                         "IP socket",
+                                         address.to_string(), fd));
+    }
+    const int copy = ::fcntl(fd, F_DUPFD_CLOEXEC, 3);
+    if (copy < 0) {
+        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {}: duplicating the passed socket (fd {}) "
+                                         "failed: {}; raise LimitNOFILE",
+                                         address.to_string(), fd, std::generic_category().message(errno)));
+    }
+    asio::ip::tcp::acceptor acceptor(io);
+    asio::error_code error;
+    acceptor.assign(local.ss_family == AF_INET6 ? asio::ip::tcp::v6() : asio::ip::tcp::v4(), copy, error);
+    if (error) {
+        ::close(copy);
+        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {} with the passed socket (fd {}): {}",
+                                         address.to_string(), fd, error.message()));
     }
     return acceptor;
 }

@@ -1,8 +1,8 @@
 #pragma once
 /// @file listen_socket.hpp
 /// Opening the listening sockets of the Modbus TCP server, with errors that say what
-/// to do (port taken, privileged port, address not on this machine), and the
-/// conversions between asio's addresses and the configuration's.
+/// to do (port taken, privileged port, address not on this machine), taking over
+/// sockets that are already listening (socket activation), and the conversions between asio's addresses and the configuration's.
 #include <asio/io_context.hpp>
 #include <asio/ip/tcp.hpp>
 #include <string>
@@ -15,6 +15,20 @@ namespace fieldbridge::northbound::modbus_tcp {
 /// an IPv4 listener shares the port, so that both can bind. Throws ModbusTcpError.
 [[nodiscard]] asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::ListenAddress& address,
                                                          bool v6_only);
+
+/// A listening TCP socket the process was given (systemd socket activation) for
+/// @p address of modbus_tcp.listen. Whoever holds it owns @p fd.
+struct InheritedListener {
+    config::ListenAddress address;
+    int fd = -1;
+};
+
+/// A new acceptor on a duplicate of the listening socket @p fd (close-on-exec); @p fd
+/// itself stays open and owned by the caller, so closing the acceptor leaves the socket
+/// listening. Throws ModbusTcpError when @p fd is not a TCP socket or cannot be
+/// duplicated.
+[[nodiscard]] asio::ip::tcp::acceptor duplicate_listen_socket(asio::io_context& io, int fd,
+                                                              const config::ListenAddress& address);
 
 /// What the operator can do about a failed bind/listen of @p address.
 [[nodiscard]] std::string listen_advice(const asio::error_code& error, const config::ListenAddress& address);

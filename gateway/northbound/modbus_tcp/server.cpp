@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <asio/steady_timer.hpp>
 #include <fmt/format.h>
+#include <unistd.h>
 #include <utility>
 
 #include "northbound/modbus_tcp/listen_socket.hpp"
@@ -59,6 +60,7 @@ ModbusTcpServer::ModbusTcpServer(asio::io_context& io, std::shared_ptr<const con
 ModbusTcpServer::~ModbusTcpServer() {
     stop();
     context_->on_closed = nullptr;
+    for (const auto& adopted : adopted_) ::close(adopted.fd);
 }
 
 std::vector<std::shared_ptr<ModbusTcpServer::Listener>> ModbusTcpServer::open_listeners(
@@ -66,6 +68,10 @@ std::vector<std::shared_ptr<ModbusTcpServer::Listener>> ModbusTcpServer::open_li
     std::vector<std::shared_ptr<Listener>> opened;
     try {
         for (const auto& address : config.listen) {
+            if (auto adopted = open_adopted(address)) {
+                opened.push_back(std::move(adopted));
+                continue;
+            }
             auto acceptor = open_listen_socket(io_, address, address.is_ipv6() && shares_port_with_ipv4(config, address));
             opened.push_back(std::make_shared<Listener>(*this, std::move(acceptor), address.to_string()));
         }
@@ -79,6 +85,16 @@ std::vector<std::shared_ptr<ModbusTcpServer::Listener>> ModbusTcpServer::open_li
     }
     return opened;
 }
+
+std::shared_ptr<ModbusTcpServer::Listener> ModbusTcpServer::open_adopted(const config::ListenAddress& address) {
+    const auto found = std::find_if(adopted_.begin(), adopted_.end(),
+                                    [&](const InheritedListener& entry) { return entry.address == address; });
+    if (found == adopted_.end()) return nullptr;
+    return std::make_shared<Listener>(*this, duplicate_listen_socket(io_, found->fd, address),
+                                      address.to_string() + " (socket passed by systemd)");
+}
+
+void ModbusTcpServer::adopt(InheritedListener listener) { adopted_.push_back(std::move(listener)); }
 
 void ModbusTcpServer::start() {
     if (running()) return;
@@ -210,6 +226,14 @@ void ModbusTcpServer::apply(std::shared_ptr<const config::ModbusTcpConfig> confi
         try {
             listeners_ = open_listeners(now);
             bound_ = now.listen;
+            for (const auto& adopted : adopted_) {
+                if (std::find(bound_.begin(), bound_.end(), adopted.address) != bound_.end()) continue;
+                log(context_->log, LogLevel::warning,
+                    "Modbus TCP: no longer accepting on {}; its socket came from systemd and stays open, so clients "
+                    "connecting there wait unanswered: remove it from the socket unit (ListenStream=) as well and "
+                    "restart fieldbridge.socket and fieldbridge.service, or list it in modbus_tcp.listen again",
+                    adopted.address.to_string());
+            }
         } catch (const ModbusTcpError& e) {
             log(context_->log, LogLevel::error, "{}; keeping the previous listen addresses", e.what());
             config::ModbusTcpConfig old = now;

@@ -13,6 +13,7 @@
 /// Usage (daemon):
 ///     ModbusTcpServer server(io, modbus_tcp_config, log);
 ///     server.routes().set(unit, target);   // before or after start()
+///     server.adopt(inherited);             // optional: sockets from systemd
 ///     server.start();                      // throws ModbusTcpError when a bind fails
 ///     ... server.apply(new_config) on reload; server.stats() for STATUS= ...
 ///     server.stop();                       // closes listeners and clients
@@ -29,6 +30,7 @@
 #include "engine/line_log.hpp"
 #include "northbound/modbus_tcp/connection.hpp"
 #include "northbound/modbus_tcp/connection_context.hpp"
+#include "northbound/modbus_tcp/listen_socket.hpp"
 #include "northbound/modbus_tcp/server_stats.hpp"
 #include "northbound/modbus_tcp/unit_router.hpp"
 
@@ -43,8 +45,16 @@ public:
     ModbusTcpServer(const ModbusTcpServer&) = delete;
     ModbusTcpServer& operator=(const ModbusTcpServer&) = delete;
 
-    /// Binds every configured address and starts accepting. All or nothing: when
-    /// one address fails, none stays open and ModbusTcpError says what to do.
+    /// Takes over a socket that already listens on @p listener.address (systemd socket
+    /// activation): from then on that address is served from it, never bound, also
+    /// after a reload that drops the address and a later one that brings it back. The
+    /// server owns the socket and closes it when destroyed; while the configuration
+    /// does not list its address the socket stays open but is not accepted from.
+    void adopt(InheritedListener listener);
+
+    /// Binds every configured address (or uses its adopted socket) and starts
+    /// accepting. All or nothing: when one address fails, none stays open and
+    /// ModbusTcpError says what to do.
     void start();
     /// Stops accepting and closes every connection. Idempotent; start() may follow.
     void stop();
@@ -69,6 +79,8 @@ private:
     struct Listener;
 
     [[nodiscard]] std::vector<std::shared_ptr<Listener>> open_listeners(const config::ModbusTcpConfig& config);
+    /// A duplicate of the adopted socket for @p address; nullptr when none was adopted.
+    [[nodiscard]] std::shared_ptr<Listener> open_adopted(const config::ListenAddress& address);
     void start_accepting();
     void close_listeners();
     void accept(const std::shared_ptr<Listener>& listener);
@@ -80,6 +92,9 @@ private:
     std::shared_ptr<ConnectionContext> context_;
     std::vector<std::shared_ptr<Listener>> listeners_;
     std::vector<config::ListenAddress> bound_;  ///< what listeners_ were opened for
+    /// Adopted sockets; listeners_ serve duplicates of them, so closing a listener
+    /// (stop, reload) never closes the socket systemd passed.
+    std::vector<InheritedListener> adopted_;
     std::unordered_map<std::uint64_t, std::shared_ptr<Connection>> connections_;
     std::uint64_t next_connection_ = 1;
     std::chrono::steady_clock::time_point last_refusal_log_{};

@@ -1,7 +1,6 @@
 #include "northbound/mqtt/mqtt_bridge.hpp"
 
 #include <algorithm>
-#include <set>
 #include <utility>
 
 #include <asio/post.hpp>
@@ -26,6 +25,7 @@ BridgeSettings bridge_settings(const config::MqttConfig& config) {
     s.reconnect_initial = config.reconnect_backoff.initial;
     s.reconnect_max = config.reconnect_backoff.max;
     s.outbox_max_bytes = config.outbox_max_bytes;
+    s.outbox_capacity = config.outbox_max_messages;
     s.max_command_bytes = config.max_command_bytes;
     s.max_command_id_length = config.max_command_id_length;
     return s;
@@ -33,7 +33,8 @@ BridgeSettings bridge_settings(const config::MqttConfig& config) {
 
 class Bridge::Impl : public std::enable_shared_from_this<Impl> {
 public:
-    Impl(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log)
+    Impl(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log,
+         std::unique_ptr<BrokerProbe> probe)
         : io_(io),
           s_(std::move(settings)),
           client_(std::move(client)),
@@ -41,9 +42,12 @@ public:
           outbox_(s_.outbox_capacity, s_.outbox_max_bytes),
           wake_timer_(io),
           diag_timer_(io),
-          reconnect_timer_(io),
           stop_timer_(io),
-          backoff_(s_.reconnect_initial) {}
+          reconnect_(io, ReconnectSettings{s_.reconnect_initial, s_.reconnect_max, s_.probe_period, s_.probe_timeout},
+                     std::move(probe), [this] {
+                         if (!stopping_) client_->connect();
+                     },
+                     log_) {}
 
     struct Device {
         std::shared_ptr<DeviceSource> source;
@@ -111,7 +115,7 @@ public:
         stop_done_ = std::move(done);
         wake_timer_.cancel();
         diag_timer_.cancel();
-        reconnect_timer_.cancel();
+        reconnect_.cancel();
         outbox_.clear();
         if (!client_->connected()) {
             finish_stop();
@@ -136,7 +140,7 @@ public:
         client_->set_events({});
         wake_timer_.cancel();
         diag_timer_.cancel();
-        reconnect_timer_.cancel();
+        reconnect_.cancel();
         stop_timer_.cancel();
     }
 
@@ -167,9 +171,18 @@ private:
     void on_connected() {
         if (stopping_) return;
         ++stats_.connects;
-        backoff_ = s_.reconnect_initial;
+        reconnect_.reset();
         log(LogLevel::info, "MQTT: connected; publishing availability, state and alarms");
         client_->subscribe(s_.prefix + "/+/cmd", s_.qos);
+        // Alarm events and command results the last connection took but never
+        // confirmed go first, in the order they were made, then what waited meanwhile.
+        if (!unconfirmed_.empty()) {
+            log(LogLevel::info, "MQTT: sending again " + std::to_string(unconfirmed_.size()) +
+                                    " event(s) and result(s) the broker had not confirmed");
+        }
+        for (auto it = unconfirmed_.rbegin(); it != unconfirmed_.rend(); ++it) outbox_.put_first(std::move(it->second));
+        stats_.resent += unconfirmed_.size();
+        unconfirmed_.clear();
         outbox_.put_first(Message{status_topic(), "online", s_.qos, true});
         // The broker may have lost every retained value (restarted without
         // persistence): publish everything again.
@@ -185,26 +198,24 @@ private:
     void on_connect_failed(const std::string& reason) {
         ++stats_.connect_failures;
         if (stopping_) return;
+        const auto delay = reconnect_.schedule();
         log(LogLevel::warning, "MQTT: cannot connect to the broker (" + reason + "); retrying in " +
-                                   std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(backoff_).count()) +
-                                   " ms; Modbus TCP and the lines are not affected");
-        schedule_reconnect();
+                                   std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(delay).count()) +
+                                   " ms, or as soon as its port accepts connections again; Modbus TCP and the "
+                                   "lines are not affected");
     }
 
     void on_connection_lost(const std::string& cause) {
         ++stats_.connection_losses;
+        // What the broker did not confirm may not have reached it: kept for the next
+        // connection (retained values are republished whole then anyway).
+        for (auto& [id, message] : in_flight_) {
+            if (!message.retained) unconfirmed_.emplace(id, std::move(message));
+        }
         in_flight_.clear();
         if (stopping_) return;
         log(LogLevel::warning, "MQTT: connection to the broker lost (" + cause + "); reconnecting");
-        schedule_reconnect();
-    }
-
-    void schedule_reconnect() {
-        reconnect_timer_.expires_after(backoff_);
-        backoff_ = std::min(backoff_ * 2, s_.reconnect_max);
-        reconnect_timer_.async_wait([weak = weak_from_this()](const std::error_code& error) {
-            if (auto self = weak.lock(); self && !error && !self->stopping_) self->client_->connect();
-        });
+        reconnect_.schedule();
     }
 
     void disconnect() {
@@ -235,7 +246,7 @@ private:
                 ++stats_.publish_failures;
                 break;
             }
-            in_flight_.insert(id);
+            in_flight_.emplace(id, std::move(m));
         }
     }
 
@@ -245,13 +256,38 @@ private:
             disconnect();
             return;
         }
-        if (in_flight_.erase(id) == 0) return;  // from an earlier connection
+        const auto it = in_flight_.find(id);
+        if (it == in_flight_.end()) return;  // from an earlier connection
         if (ok) {
             ++stats_.published;
         } else {
             ++stats_.publish_failures;
+            // Paho fails what is in flight when the connection breaks, maybe before it
+            // reports the loss: keep events and results for the next connection, and
+            // drop them only if the connection turns out to be fine (a refusal).
+            if (!it->second.retained) {
+                unconfirmed_.emplace(id, std::move(it->second));
+                settle_unconfirmed();
+            }
         }
+        in_flight_.erase(it);
         pump();
+    }
+
+    void settle_unconfirmed() {
+        if (settle_pending_) return;
+        settle_pending_ = true;
+        asio::post(io_, [weak = weak_from_this()] {
+            auto self = weak.lock();
+            if (!self) return;
+            self->settle_pending_ = false;
+            if (!self->client_->connected() || self->unconfirmed_.empty()) return;
+            self->log(LogLevel::warning, "MQTT: the broker refused " + std::to_string(self->unconfirmed_.size()) +
+                                             " publication(s) on a working connection; dropped (check its ACL for " +
+                                             self->s_.prefix + "/#)");
+            self->stats_.refused += self->unconfirmed_.size();
+            self->unconfirmed_.clear();
+        });
     }
 
     // ---- devices --------------------------------------------------------------
@@ -365,6 +401,8 @@ private:
                            {"published", s.published},
                            {"publish_failures", s.publish_failures},
                            {"dropped", s.dropped},
+                           {"resent", s.resent},
+                           {"refused", s.refused},
                            {"superseded", s.superseded},
                            {"state_messages", s.state_messages},
                            {"alarm_events", s.alarm_events},
@@ -504,15 +542,19 @@ private:
     std::map<std::string, std::unique_ptr<Device>, std::less<>> devices_;
     asio::steady_timer wake_timer_;
     asio::steady_timer diag_timer_;
-    asio::steady_timer reconnect_timer_;
     asio::steady_timer stop_timer_;
-    engine::Duration backoff_;
+    ReconnectSchedule reconnect_;
     bool started_ = false;
     bool stopping_ = false;
     bool wake_armed_ = false;
     engine::TimePoint wake_at_{};
     std::optional<engine::TimePoint> device_wake_;
-    std::set<std::uint64_t> in_flight_;
+    /// Handed to the client, not yet confirmed, by publication id (= sending order).
+    std::map<std::uint64_t, Message> in_flight_;
+    /// Transient messages whose publication failed or whose connection was lost,
+    /// sent again first on the next connection.
+    std::map<std::uint64_t, Message> unconfirmed_;
+    bool settle_pending_ = false;
     std::uint64_t offline_id_ = 0;
     std::function<void()> stop_done_;
     BridgeStats stats_;
@@ -521,8 +563,9 @@ private:
     std::chrono::steady_clock::time_point last_drop_log_{};
 };
 
-Bridge::Bridge(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log)
-    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(client), std::move(log))) {}
+Bridge::Bridge(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log,
+               std::unique_ptr<BrokerProbe> probe)
+    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(client), std::move(log), std::move(probe))) {}
 
 Bridge::~Bridge() { impl_->shutdown(); }
 

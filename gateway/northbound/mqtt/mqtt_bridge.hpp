@@ -7,9 +7,12 @@
 /// bounded Outbox and are handed to the client while fewer than `max_in_flight` are
 /// unacknowledged; while the broker is away nothing but alarm events and command
 /// results is kept (bounded), since state and alarm sets are retained values that
-/// are published again, whole, on every new connection. A lost connection or a
-/// failed attempt is retried after a back-off (doubling from `reconnect_initial`
-/// up to `reconnect_max`).
+/// are published again, whole, on every new connection. Events and results handed to
+/// the client but not confirmed when the connection broke are sent again first on
+/// the next one (at least once). A lost connection or a failed attempt is retried
+/// after a back-off (doubling from `reconnect_initial` up to `reconnect_max`), or as
+/// soon as a probe sees a broker that was down accept connections again
+/// (ReconnectSchedule).
 // Standard headers before asio's (see daemon/periodic.hpp).
 #include <chrono>
 #include <cstdint>
@@ -27,8 +30,10 @@
 #include "engine/line_log.hpp"
 #include "northbound/mqtt/alarm_tracker.hpp"
 #include "northbound/mqtt/device_source.hpp"
+#include "northbound/mqtt/broker_probe.hpp"
 #include "northbound/mqtt/mqtt_client.hpp"
 #include "northbound/mqtt/outbox.hpp"
+#include "northbound/mqtt/reconnect_schedule.hpp"
 #include "northbound/mqtt/state_throttle.hpp"
 
 namespace fieldbridge::northbound::mqtt {
@@ -41,6 +46,10 @@ struct BridgeSettings {
     engine::Duration diag_period = std::chrono::seconds{10};
     engine::Duration reconnect_initial = std::chrono::seconds{1};
     engine::Duration reconnect_max = std::chrono::seconds{60};
+    /// While a reconnect wait is longer than this, the broker's port is probed this
+    /// often; a broker seen down that accepts connections again is connected to at once.
+    engine::Duration probe_period = std::chrono::seconds{1};
+    std::chrono::milliseconds probe_timeout{800};
     /// Every device is looked at this often even without a change notification
     /// (online transitions of a device that never answered, alarm holds).
     engine::Duration watch_period = std::chrono::seconds{1};
@@ -70,6 +79,8 @@ struct BridgeStats {
     std::uint64_t published = 0;         ///< acknowledged (QoS 1/2) or handed over (QoS 0)
     std::uint64_t publish_failures = 0;  ///< refused by the client or failed
     std::uint64_t dropped = 0;           ///< outbox full
+    std::uint64_t resent = 0;            ///< events / results sent again after a lost connection
+    std::uint64_t refused = 0;           ///< events / results the broker failed on a working connection
     std::uint64_t superseded = 0;        ///< a retained value replaced before it was sent
     std::uint64_t state_messages = 0;
     std::uint64_t alarm_events = 0;
@@ -83,7 +94,9 @@ struct BridgeStats {
 
 class Bridge {
 public:
-    Bridge(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log = {});
+    /// @p probe: the broker reachability check while reconnecting (nullptr: back-off only).
+    Bridge(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log = {},
+           std::unique_ptr<BrokerProbe> probe = nullptr);
     ~Bridge();
     Bridge(const Bridge&) = delete;
     Bridge& operator=(const Bridge&) = delete;

@@ -4,6 +4,7 @@
 
 #include <asio/post.hpp>
 
+#include "config/mqtt_uri.hpp"
 #include "daemon/engine_component.hpp"
 #include "northbound/mqtt/paho_client.hpp"
 
@@ -40,7 +41,13 @@ void MqttComponent::build() {
     // Throws (with the URI) when the client library refuses the configuration: the
     // daemon then refuses to start.
     auto client = clients_(io_, mqtt, mqtt.prefix + "/status");
-    bridge_ = std::make_unique<Bridge>(io_, bridge_settings(mqtt), std::move(client), daemon::engine_log_sink(logger_));
+    // The URI was validated with the configuration; an unparsable one only loses the probe.
+    std::unique_ptr<BrokerProbe> probe;
+    if (const auto uri = config::parse_mqtt_uri(mqtt.uri)) {
+        probe = std::make_unique<TcpBrokerProbe>(io_, uri.value->host, uri.value->port);
+    }
+    bridge_ = std::make_unique<Bridge>(io_, bridge_settings(mqtt), std::move(client), daemon::engine_log_sink(logger_),
+                                       std::move(probe));
     bridge_->set_diag_provider([this] {
         nlohmann::json out = nlohmann::json::object();
         if (engine::Engine* e = engine_ ? engine_() : nullptr) out = engine_diag_.collect(*e, engine::Clock::now());

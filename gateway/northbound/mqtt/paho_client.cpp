@@ -13,6 +13,7 @@
 #include <mqtt/async_client.h>
 
 #include "northbound/mqtt/inbound_gate.hpp"
+#include "northbound/mqtt/tls_advice.hpp"
 
 namespace fieldbridge::northbound::mqtt {
 
@@ -135,9 +136,13 @@ public:
                                    if (ok) {
                                        if (core.events_.connected) core.events_.connected();
                                    } else if (core.events_.connect_failed) {
-                                       core.events_.connect_failed(token.reason);
+                                       core.events_.connect_failed(
+                                           core.options_.tls
+                                               ? token.reason + "; " + tls_failure_advice(core.options_.tls_files)
+                                               : token.reason);
                                    }
                                }};
+
     Listener publish_listener_{*this, [](Core& core, const TokenInfo& token, bool ok) {
                                    if (core.events_.published) core.events_.published(token.id, ok);
                                }};
@@ -244,6 +249,9 @@ void PahoClient::connect() {
             if (!o.tls_files.key_file.empty()) ssl.set_private_key(o.tls_files.key_file);
             ssl.set_enable_server_cert_auth(o.tls_files.verify);
             ssl.set_verify(o.tls_files.verify);
+            // No ssl_options::set_error_handler(): with Debian 12's Paho it crashes
+            // (a null callback on Paho's thread, seen under ASan); tls_failure_advice()
+            // names the settings instead.
             options.set_ssl(std::move(ssl));
         }
         core_->client_->connect(options, nullptr, core_->connect_listener_);

@@ -299,7 +299,19 @@ mqtt:
 class CellTestCase(unittest.TestCase):
     """A simulated cell: fieldbridge-sim with line-a (XEG @2 unit 1, EXCD203MB @3 unit 2,
     WTEC ASCII @5 unit 3, broadcast unit 100) and line-b (WTEC RTU @1 unit 4), the
-    gateway in front of it, optionally the R6 (unit 50) and a broker."""
+    gateway in front of it, optionally the R6 (unit 50) and a broker.
+
+    A test case may set, before start_cell(): mqtt_config (the gateway's `mqtt:`
+    section, formatted with mqtt_port), broker_listener (mosquitto's listener lines
+    after `listener PORT 127.0.0.1`, e.g. TLS files), broker_persistence (True: the
+    broker keeps retained messages and persistent sessions across a stop_broker() /
+    start_broker()) and mqtt_client_args (added to every mosquitto_sub /
+    mosquitto_pub, e.g. --cafile)."""
+
+    mqtt_config = MQTT_CONFIG
+    broker_listener = "allow_anonymous true\n"
+    broker_persistence = False
+    mqtt_client_args = ()
 
     def setUp(self):
         if PYMODBUS_ERROR is not None:
@@ -354,9 +366,12 @@ class CellTestCase(unittest.TestCase):
     # -- starting --------------------------------------------------------------------
 
     def start_cell(self, r6=False, mqtt=False, extra_devices_a="", extra_devices_b="", extra_lines="",
-                   rules="", max_connections=64, sim_line_b="wtec-rtu@1", sim_extra=(), before_gateway=None):
+                   rules="", max_connections=64, sim_line_b="wtec-rtu@1", sim_extra=(), before_gateway=None,
+                   launcher=None, wait_ready=True):
         """Simulator, broker (mqtt=True), before_gateway() if given, gateway; returns
-        when the gateway is ready."""
+        when the gateway is ready (wait_ready=False: as soon as it was started).
+        launcher() returns the command line put before the gateway's own (e.g.
+        systemd-socket-activate), called once the ports are chosen."""
         self.tcp_port = free_port()
         self.r6_port = free_port() if r6 else None
         args = ["--bus", self.path("line-a") + ":hiwin-xeg@2,excd203mb@3,wtec-ascii@5",
@@ -375,16 +390,20 @@ class CellTestCase(unittest.TestCase):
             extra_devices_a=extra_devices_a, extra_devices_b=extra_devices_b, extra_lines=extra_lines,
             rules=rules,
             upstreams=UPSTREAM_CONFIG.format(r6_port=self.r6_port) if r6 else "",
-            mqtt=MQTT_CONFIG.format(mqtt_port=self.mqtt_port) if mqtt else "")
+            mqtt=self.mqtt_config.format(mqtt_port=self.mqtt_port) if mqtt else "")
         self.config_path = self.path("gateway.yaml")
         with open(self.config_path, "w", encoding="utf-8") as f:
             f.write(config)
-        self.start_gateway()
+        self.start_gateway(launcher() if launcher else (), wait_ready)
 
-    def start_gateway(self):
-        self.gateway = Process("fieldbridge", [GATEWAY, "--config", self.config_path],
+    def start_gateway(self, launcher=(), wait_ready=True):
+        self.gateway = Process("fieldbridge", list(launcher) + [GATEWAY, "--config", self.config_path],
                                self.path("gateway.log"), env=environment())
         self.processes.append(self.gateway)
+        if wait_ready:
+            self.wait_ready()
+
+    def wait_ready(self):
         if self.gateway.wait_line(lambda line: "ready:" in line, START_TIMEOUT) is None:
             self.fail("fieldbridge did not log 'ready:' within %.0f s:\n%s"
                       % (START_TIMEOUT, self.gateway.text()))
@@ -392,11 +411,22 @@ class CellTestCase(unittest.TestCase):
     def start_broker(self):
         conf = self.path("mosquitto.conf")
         with open(conf, "w", encoding="utf-8") as f:
-            f.write("listener %d 127.0.0.1\nallow_anonymous true\npersistence false\n" % self.mqtt_port)
+            f.write("listener %d 127.0.0.1\n%s%s" % (self.mqtt_port, self.broker_listener, self._persistence()))
         self.broker = Process("mosquitto", ["mosquitto", "-c", conf], self.path("mosquitto.log"))
         self.processes.append(self.broker)
         if not wait_port(self.mqtt_port, START_TIMEOUT, self.broker.running):
             self.fail("mosquitto did not listen on %d:\n%s" % (self.mqtt_port, _read(self.broker.log_path)))
+
+    def _persistence(self):
+        if not self.broker_persistence:
+            return "persistence false\n"
+        # mosquitto started as root runs as user mosquitto: it must write there.
+        directory = self.path("broker-db")
+        if not os.path.isdir(directory):
+            os.chmod(self.tmp, 0o711)
+            os.mkdir(directory)
+            os.chmod(directory, 0o777)
+        return "persistence true\npersistence_location %s/\n" % directory
 
     def stop_broker(self):
         self.broker.signal(signal.SIGTERM)
@@ -404,9 +434,14 @@ class CellTestCase(unittest.TestCase):
         self.processes.remove(self.broker)
         self.broker.kill()
 
-    def subscribe(self, *topics):
+    def subscribe(self, *topics, session=None):
+        """mosquitto_sub on topics; session: a client id for a persistent session (with
+        broker_persistence it gets, once it has reconnected by itself, what was
+        published while the broker was restarting)."""
         command = ["mosquitto_sub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
-                   "-F", "%r %t %p"]
+                   "-F", "%r %t %p"] + list(self.mqtt_client_args)
+        if session is not None:
+            command += ["-c", "-i", session]
         for topic in topics:
             command += ["-t", topic]
         sub = Subscriber("mosquitto_sub", command, self.path("sub-%d.log" % len(self.processes)),
@@ -419,7 +454,7 @@ class CellTestCase(unittest.TestCase):
 
     def publish(self, topic, payload, retain=False):
         command = ["mosquitto_pub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
-                   "-t", topic, "-m", payload]
+                   "-t", topic, "-m", payload] + list(self.mqtt_client_args)
         if retain:
             command.append("-r")
         done = subprocess.run(command, capture_output=True, text=True, timeout=IO_TIMEOUT)

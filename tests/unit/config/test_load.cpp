@@ -153,6 +153,7 @@ upstreams:
     CHECK(config->mqtt.max_queued_commands == 64);
     CHECK(config->mqtt.max_queued_command_bytes == 1024 * 1024);
     CHECK(config->mqtt.outbox_max_bytes == 4 * 1024 * 1024);
+    CHECK(config->mqtt.outbox_max_messages == 512);
     CHECK(tcp.max_connections_per_client == 16);
     CHECK(tcp.allow.empty());
     CHECK(tcp.rules.empty());

@@ -82,6 +82,7 @@ mqtt:
   max_queued_commands: 0
   max_queued_command_bytes: 10
   outbox_max_bytes: 1024
+  outbox_max_messages: 15
 )";
     CHECK_REPORTS(yaml, "upstreams[0].sequence_max_hold", 3, 52, "expected 10ms..10s");
     CHECK_REPORTS(yaml, "mqtt.max_command_bytes", 5, 22, "expected 256..1048576");
@@ -89,7 +90,8 @@ mqtt:
     CHECK_REPORTS(yaml, "mqtt.max_queued_commands", 7, 24, "expected 1..4096");
     CHECK_REPORTS(yaml, "mqtt.max_queued_command_bytes", 8, 29, "expected 1024..67108864");
     CHECK_REPORTS(yaml, "mqtt.outbox_max_bytes", 9, 21, "expected 65536..268435456");
-    CHECK(diagnostics_of(yaml).size() == 6);
+    CHECK_REPORTS(yaml, "mqtt.outbox_max_messages", 10, 24, "expected 16..1000000");
+    CHECK(diagnostics_of(yaml).size() == 7);
 }
 
 TEST_CASE("upstreams") {

@@ -95,6 +95,84 @@ TEST_CASE("IPv4 and IPv6 listeners on one port both bind and both serve") {
     }
 }
 
+/// A socket listening on a free loopback port, as systemd would pass it: the fd is
+/// released to the caller.
+[[nodiscard]] InheritedListener listening_socket(asio::io_context& io) {
+    asio::ip::tcp::acceptor acceptor(io, asio::ip::tcp::endpoint(asio::ip::address_v4::loopback(), 0));
+    const auto port = acceptor.local_endpoint().port();
+    return InheritedListener{config::ListenAddress{"127.0.0.1", port}, acceptor.release()};
+}
+
+/// The loopback configuration listening only on @p inherited's address.
+[[nodiscard]] config::ModbusTcpConfig listening_on(const InheritedListener& inherited) {
+    auto config = loopback_config();
+    config.listen = {inherited.address};
+    return config;
+}
+
+[[nodiscard]] bool accepts_connections(asio::io_context& io, ModbusTcpServer& server, std::uint16_t port) {
+    asio::ip::tcp::socket client(io);
+    asio::error_code error;
+    client.connect(asio::ip::tcp::endpoint(asio::ip::address_v4::loopback(), port), error);
+    if (error) return false;
+    // The server's accept runs on the loop: run it until it counted the connection.
+    const auto before = server.stats().connections_accepted;
+    const auto deadline = std::chrono::steady_clock::now() + wait_limit;
+    while (server.stats().connections_accepted == before && std::chrono::steady_clock::now() < deadline) {
+        io.run_for(std::chrono::milliseconds{10});
+    }
+    return server.stats().connections_accepted > before;
+}
+
+TEST_CASE("an adopted socket is served instead of binding its address, across stop and start") {
+    asio::io_context io;
+    const auto inherited = listening_socket(io);
+    const auto port = inherited.address.port;
+    ModbusTcpServer server(io, shared(listening_on(inherited)), {});
+    server.adopt(inherited);
+    // Binding 127.0.0.1:port would fail: the adopted socket listens there.
+    server.start();
+    CHECK(server.port() == port);
+    CHECK(accepts_connections(io, server, port));
+    server.stop();
+    server.start();
+    CHECK(accepts_connections(io, server, port));
+}
+
+TEST_CASE("a reload keeps an adopted socket, and one that drops its address can bring it back") {
+    asio::io_context io;
+    const auto inherited = listening_socket(io);
+    const auto port = inherited.address.port;
+    const auto config = listening_on(inherited);
+    std::vector<std::string> lines;
+    engine::LogSink sink{[&](engine::LogLevel, std::string_view line) { lines.emplace_back(line); }};
+    ModbusTcpServer server(io, shared(config), sink);
+    server.adopt(inherited);
+    server.start();
+
+    auto more = config;
+    more.listen.push_back(config::ListenAddress{"127.0.0.1", 0});
+    server.apply(shared(more));
+    CHECK(server.local_endpoints().size() == 2);
+    CHECK(accepts_connections(io, server, port));
+
+    auto dropped = config;
+    dropped.listen = {config::ListenAddress{"127.0.0.1", 0}};
+    server.apply(shared(dropped));
+    REQUIRE(server.local_endpoints().size() == 1);
+    CHECK(server.port() != port);
+    bool warned = false;
+    for (const auto& line : lines) {
+        warned = warned || line.find("no longer accepting on 127.0.0.1:" + std::to_string(port) +
+                                     "; its socket came from systemd and stays open") != std::string::npos;
+    }
+    CHECK(warned);
+
+    server.apply(shared(config));  // back: served from the adopted socket again, not bound
+    CHECK(server.port() == port);
+    CHECK(accepts_connections(io, server, port));
+}
+
 TEST_CASE("client addresses map to the configuration's form") {
     CHECK(to_ip_address(asio::ip::make_address("127.0.0.1")) == *config::parse_ip_address("127.0.0.1"));
     CHECK(to_ip_address(asio::ip::make_address("::ffff:10.1.2.3")) == *config::parse_ip_address("10.1.2.3"));

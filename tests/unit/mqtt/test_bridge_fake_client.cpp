@@ -272,3 +272,107 @@ TEST_CASE("bridge: an oversized command is refused unread; a long id is echoed c
     log->events.inbound_dropped(5);
     CHECK(bridge.stats().commands_dropped == 5);
 }
+
+namespace {
+
+/// A probe whose answer the test sets.
+class ScriptedProbe final : public fm::BrokerProbe {
+public:
+    explicit ScriptedProbe(asio::io_context& io, std::shared_ptr<bool> reachable, std::shared_ptr<int> probes)
+        : io_(io), reachable_(std::move(reachable)), probes_(std::move(probes)) {}
+    void probe(std::chrono::milliseconds, std::function<void(bool)> done) override {
+        ++*probes_;
+        asio::post(io_, [done = std::move(done), reachable = *reachable_] { done(reachable); });
+    }
+    void cancel() override {}
+
+private:
+    asio::io_context& io_;
+    std::shared_ptr<bool> reachable_;
+    std::shared_ptr<int> probes_;
+};
+
+/// A bridge whose broker refuses every attempt, with a scripted probe.
+struct ProbeRig {
+    ProbeRig(bool port_open, fe::Duration initial, fe::Duration max) {
+        log->accept_connect = false;
+        *reachable = port_open;
+        auto settings = bridge_settings();
+        settings.reconnect_initial = initial;
+        settings.reconnect_max = max;
+        settings.probe_period = 20ms;
+        bridge = std::make_unique<fm::Bridge>(io, settings, std::make_unique<ScriptedClient>(io, log),
+                                              fe::LogSink{}, std::make_unique<ScriptedProbe>(io, reachable, probes));
+        bridge->start();
+    }
+    asio::io_context io;
+    std::shared_ptr<ScriptedClient::Log> log = std::make_shared<ScriptedClient::Log>();
+    std::shared_ptr<bool> reachable = std::make_shared<bool>(false);
+    std::shared_ptr<int> probes = std::make_shared<int>(0);
+    std::unique_ptr<fm::Bridge> bridge;
+};
+
+}  // namespace
+
+TEST_CASE("bridge: a broker seen down is connected to as soon as its port accepts again, not after the back-off") {
+    ProbeRig rig(false, 10ms, 10s);
+    // Waits of 10, 20, 40, 80, 160 ms, then 320 ms: probed every 20 ms from the third on.
+    const auto until = std::chrono::steady_clock::now() + 3s;
+    while (rig.bridge->stats().connect_failures < 6 && std::chrono::steady_clock::now() < until) run(rig.io, 2ms);
+    REQUIRE(rig.bridge->stats().connect_failures == 6);
+    CHECK(*rig.probes > 0);
+    // The broker is back at the start of a 320 ms wait: connected within about one
+    // probe period.
+    rig.log->accept_connect = true;
+    *rig.reachable = true;
+    const auto back = fe::Clock::now();
+    while (!rig.bridge->connected() && std::chrono::steady_clock::now() < until) run(rig.io, 2ms);
+    REQUIRE(rig.bridge->connected());
+    CHECK(rig.log->connects.size() == 7);
+    CHECK(rig.log->connects.back() - back < 150ms);
+}
+
+TEST_CASE("bridge: a reachable broker that refuses the connection is tried only at the back-off's pace") {
+    ProbeRig rig(true, 100ms, 400ms);
+    run(rig.io, 750ms);  // attempts at 0, 100, 300, 700 ms
+    CHECK(*rig.probes > 5);
+    CHECK(rig.log->connects.size() <= 4);
+    for (std::size_t i = 1; i < rig.log->connects.size(); ++i) {
+        CHECK(rig.log->connects[i] - rig.log->connects[i - 1] >= 100ms);
+    }
+}
+
+TEST_CASE("bridge: events in flight when the connection breaks are sent again first, in order, on the next one") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
+    auto source = std::make_shared<FakeSource>(io, "g1");
+    bridge.set_sources({source});
+    bridge.start();
+    run(io, 30ms);
+    REQUIRE(log->connected);
+    for (auto id : log->ids) log->events.published(id, true);
+    log->ids.clear();
+    run(io, 10ms);
+    const auto before = log->published.size();
+    source->set_alarms({fe::Alarm{"a1", "test alarm", fe::Severity::error, "input 0x0301"}});  // raised event + active set, handed over
+    run(io, 20ms);
+    REQUIRE(log->published.size() > before);
+    // Paho fails the unconfirmed publications, then reports the loss.
+    log->connected = false;
+    for (auto id : log->ids) log->events.published(id, false);
+    log->ids.clear();
+    log->events.connection_lost("broker went away");
+    source->set_alarms({});  // made while disconnected
+    run(io, 200ms);             // back-off, then connected again
+    REQUIRE(log->connected);
+    std::vector<std::string> events;
+    for (std::size_t i = before; i < log->published.size(); ++i) {
+        const auto& m = log->published[i];
+        if (m.topic != "p/g1/alarm" || m.retained) continue;
+        const auto body = json::parse(m.payload);
+        events.push_back(body["event"].get<std::string>() + " " + body["code"].get<std::string>());
+    }
+    CHECK(events == std::vector<std::string>{"raised a1", "raised a1", "cleared a1"});
+    CHECK(bridge.stats().resent == 1);
+}
