@@ -29,7 +29,6 @@ engine::Duration ReconnectSchedule::schedule() {
     const engine::Duration delay = backoff_;
     backoff_ = std::min(backoff_ * 2, s_.max);
     due_ = engine::Clock::now() + delay;
-    seen_down_ = false;
     timer_.expires_after(delay);
     timer_.async_wait([this, alive = std::weak_ptr<bool>(alive_)](const std::error_code& error) {
         const auto live = alive.lock();
@@ -40,7 +39,10 @@ engine::Duration ReconnectSchedule::schedule() {
     return delay;
 }
 
-void ReconnectSchedule::reset() { backoff_ = s_.initial; }
+void ReconnectSchedule::reset() {
+    backoff_ = s_.initial;
+    seen_down_ = false;
+}
 
 void ReconnectSchedule::cancel() {
     timer_.cancel();
@@ -67,6 +69,9 @@ void ReconnectSchedule::on_probe(bool reachable) {
         const auto early = std::chrono::duration_cast<std::chrono::milliseconds>(due_ - engine::Clock::now());
         log_(LogLevel::info, "MQTT: the broker accepts connections again; connecting now (" +
                                  std::to_string(std::max<long long>(early.count(), 0)) + " ms before the back-off)");
+        // Once per outage: if this attempt fails too, the broker refuses rather than
+        // being down, and the back-off's pace applies again.
+        seen_down_ = false;
         timer_.cancel();
         connect_now();
         return;

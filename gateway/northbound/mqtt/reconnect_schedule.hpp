@@ -63,8 +63,9 @@ private:
     asio::steady_timer probe_timer_;
     engine::Duration backoff_;
     engine::TimePoint due_{};
-    /// A probe found the port closed since the wait began: the next open port means
-    /// the broker came back.
+    /// A probe found the port closed since the last connection (or the last early
+    /// attempt): the next open port means the broker came back. Kept across waits, so
+    /// a broker back at the start of a wait is noticed at the first probe.
     bool seen_down_ = false;
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
