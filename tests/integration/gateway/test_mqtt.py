@@ -325,8 +325,8 @@ class LongBrokerOutage(MqttCell):
     after an outage of 8 s; the probe must bring state back within 2 s anyway."""
 
     broker_persistence = True
-    mqtt_config = MQTT_CONFIG.replace("reconnect_backoff: {{initial: 200ms, max: 1s}}",
-                                      "reconnect_backoff: {{initial: 100ms, max: 60s}}")
+    mqtt_config = gatewaylib.MQTT_CONFIG.replace("reconnect_backoff: {{initial: 200ms, max: 1s}}",
+                                                 "reconnect_backoff: {{initial: 100ms, max: 60s}}")
     OUTAGE = 8.0
 
     def test_state_back_within_2s_and_every_alarm_event_of_the_outage_delivered(self):
