@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   # toolchain
   build-essential cmake ninja-build g++ pkg-config
+  clang libclang-rt-14-dev  # the fuzz build (tests/fuzz): clang++ and its libFuzzer
   # libraries (docs/dependencies.md says why each one is here)
   libmodbus-dev libpaho-mqttpp-dev libpaho-mqtt-dev libssl-dev libyaml-cpp-dev
   libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev

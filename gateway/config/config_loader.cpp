@@ -12,6 +12,7 @@
 #include "config/diagnostic_sink.hpp"
 #include "config/raw_parse.hpp"
 #include "config/validate.hpp"
+#include "config/yaml_documents.hpp"
 
 namespace fieldbridge::config {
 
@@ -30,23 +31,23 @@ namespace {
 [[nodiscard]] std::shared_ptr<const Config> load(std::string_view yaml, const std::string& file_name,
                                                  const std::filesystem::path& base_dir) {
     DiagnosticSink sink(file_name);
-    std::vector<YAML::Node> documents;
+    YamlDocuments documents;
     try {
-        documents = YAML::LoadAll(std::string(yaml));
+        documents = read_documents(yaml);
     } catch (const YAML::Exception& e) {
         // A syntax error stops the YAML parser: nothing after it can be read.
         sink.error(to_mark(e.mark, Mark{1, 1}), "", "YAML syntax error: " + e.msg + "; fix the YAML at this position");
         throw ConfigError(sink.take_sorted());
     }
-    if (documents.empty() || documents.front().IsNull()) {
+    if (!documents.first || documents.first.IsNull()) {
         sink.error(Mark{1, 1}, "", "the configuration is empty; expected at least gateway: { id: <name> }");
         throw ConfigError(sink.take_sorted());
     }
-    if (documents.size() > 1) {
-        sink.error(to_mark(documents[1].Mark(), Mark{1, 1}), "",
+    if (documents.second) {
+        sink.error(to_mark(*documents.second, Mark{1, 1}), "",
                    "a second YAML document starts here (---); expected a single document");
     }
-    const RawConfig raw = parse_raw(documents.front(), sink);
+    const RawConfig raw = parse_raw(documents.first, sink);
     validate(raw, base_dir, sink);
     if (!sink.empty()) {
         throw ConfigError(sink.take_sorted());

@@ -29,6 +29,25 @@ gateway:
     CHECK(unclosed[0].message.find("YAML syntax error") != std::string::npos);
 }
 
+// Found by fuzz_config_loader: yaml-cpp 0.7's LoadAll never returns on a stray ','
+// (jbeder/yaml-cpp #1040): it appends empty documents without reading on, until the
+// memory runs out. The loader must report it and return.
+TEST_CASE("a stray comma is a YAML syntax error at its position, not a hang") {
+    struct Case {
+        const char* yaml;
+        int line;
+    };
+    for (const auto& [yaml, line] : {Case{",", 1}, Case{"gateway: {id: t}\n,\n", 2},
+                                    Case{"gateway:\n  id: t\n, x\n", 3}}) {
+        const auto diagnostics = diagnostics_of(yaml);
+        INFO(dump(diagnostics));
+        REQUIRE(diagnostics.size() == 1);
+        CHECK(diagnostics[0].line == line);
+        CHECK(diagnostics[0].column == 1);
+        CHECK(diagnostics[0].message.find("YAML syntax error") != std::string::npos);
+    }
+}
+
 TEST_CASE("empty files, several documents, a root that is not a map") {
     for (const auto* empty : {"", "# only a comment\n", "---\n"}) {
         const auto diagnostics = diagnostics_of(empty);

@@ -1,0 +1,60 @@
+// The MQTT command parser (northbound/mqtt/command_parser.hpp, parse_command) as the
+// bridge calls it for a `<prefix>/<device>/cmd` payload: with the device's command
+// set and its register image (WTEC `grip` / `release` read the init direction).
+// A parsed command's requests go to the device as they are, so each must encode;
+// a refusal must say why.
+// Input: one byte choosing the command set, one byte choosing how many registers
+// (0-3) the image holds, 5 bytes per register (table, address, value), then the payload.
+
+#include <cstddef>
+#include <cstdint>
+#include <iterator>
+#include <stdexcept>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "fuzz_input.hpp"
+#include "northbound/mqtt/command_parser.hpp"
+
+namespace {
+
+using fieldbridge::fuzz::check;
+namespace mqtt = fieldbridge::northbound::mqtt;
+namespace engine = fieldbridge::engine;
+
+constexpr mqtt::CommandSet command_sets[] = {mqtt::CommandSet::xeg, mqtt::CommandSet::excd, mqtt::CommandSet::wtec,
+                                             mqtt::CommandSet::r6, mqtt::CommandSet::generic};
+constexpr engine::Table tables[] = {engine::Table::coils, engine::Table::discrete_inputs, engine::Table::holding,
+                                    engine::Table::input};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    fieldbridge::fuzz::FuzzInput input(data, size);
+    const auto set = command_sets[input.byte() % std::size(command_sets)];
+    std::vector<mqtt::RawRegister> registers(input.byte() % 4);
+    for (auto& r : registers) {
+        r.table = tables[input.byte() % std::size(tables)];
+        r.address = static_cast<std::uint16_t>(input.byte() << 8 | input.byte());
+        r.value = static_cast<std::uint16_t>(input.byte() << 8 | input.byte());
+    }
+    const auto payload_bytes = input.rest();
+    const std::string_view payload(reinterpret_cast<const char*>(payload_bytes.data()), payload_bytes.size());
+
+    const auto result = mqtt::parse_command(payload, set, registers);
+    if (const auto* parsed = std::get_if<mqtt::ParsedCommand>(&result)) {
+        check(!parsed->requests.empty() && !parsed->op.empty());
+        check(parsed->id.is_string() || parsed->id.is_number());
+        for (const auto& request : parsed->requests) {
+            try {
+                (void)fieldbridge::protocol::encode_request(request);
+            } catch (const std::invalid_argument&) {
+                fieldbridge::fuzz::invariant_failed();  // a parsed command the wire cannot carry
+            }
+        }
+    } else {
+        check(!std::get<mqtt::CommandError>(result).message.empty());
+    }
+    return 0;
+}
