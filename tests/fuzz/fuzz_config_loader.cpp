@@ -13,18 +13,17 @@
 #include "fuzz_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    using fieldbridge::fuzz::check;
     namespace config = fieldbridge::config;
     const std::string_view yaml(reinterpret_cast<const char*>(data), size);
     try {
         // A directory that does not exist: relative TLS and password files resolve
         // against it and are never found, so the harness reads no file of the machine.
         const auto loaded = config::load_config_string(yaml, "/nonexistent-fieldbridge-fuzz/fuzz.yaml");
-        check(loaded != nullptr);
+        FB_FUZZ_CHECK(loaded != nullptr);
     } catch (const config::ConfigError& error) {
-        check(!error.diagnostics().empty());
+        FB_FUZZ_CHECK(!error.diagnostics().empty());
         for (const auto& diagnostic : error.diagnostics()) {
-            check(!diagnostic.message.empty());
+            FB_FUZZ_CHECK(!diagnostic.message.empty());
         }
     }
     return 0;

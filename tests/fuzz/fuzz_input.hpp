@@ -7,19 +7,28 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <span>
 #include <vector>
 
 namespace fieldbridge::fuzz {
 
-/// Aborts the harness: libFuzzer reports it as a crash with the input that caused it.
-[[noreturn]] inline void invariant_failed() { __builtin_trap(); }
-
-/// Checks an invariant of the code under test; a violation is a crash.
-inline void check(bool holds) {
-    if (!holds) invariant_failed();
+/// Prints which invariant broke, where, and aborts: libFuzzer reports a crash and
+/// saves the input. (A bare __builtin_trap() loses the line: the optimiser merges the
+/// traps of one function.)
+[[noreturn]] inline void invariant_failed(const char* condition, const char* file, int line) {
+    std::fprintf(stderr, "%s:%d: invariant of the code under test broken: %s\n", file, line, condition);
+    std::abort();
 }
+
+}  // namespace fieldbridge::fuzz
+
+/// Checks an invariant of the code under test; a violation is a crash that names it.
+#define FB_FUZZ_CHECK(condition) \
+    ((condition) ? void(0) : ::fieldbridge::fuzz::invariant_failed(#condition, __FILE__, __LINE__))
+
+namespace fieldbridge::fuzz {
 
 /// Reads an input from the front; past the end every read is 0 / empty.
 class FuzzInput {

@@ -14,7 +14,6 @@
 
 namespace {
 
-using fieldbridge::fuzz::check;
 namespace protocol = fieldbridge::protocol;
 
 struct Framed {
@@ -27,24 +26,24 @@ void drain(protocol::Bytes& buffer, Framed& out) {
     while (!out.closed && !buffer.empty()) {
         const auto result = protocol::decode_mbap(buffer);
         if (result.need_more()) {
-            check(result.consumed == 0);
+            FB_FUZZ_CHECK(result.consumed == 0);
             return;
         }
-        check(result.consumed <= buffer.size());
+        FB_FUZZ_CHECK(result.consumed <= buffer.size());
         if (result.malformed()) {
-            check(result.consumed == buffer.size());
-            check(result.error != protocol::DecodeError::none);
+            FB_FUZZ_CHECK(result.consumed == buffer.size());
+            FB_FUZZ_CHECK(result.error != protocol::DecodeError::none);
             out.closed = true;
             return;
         }
         const auto& frame = result.value;
         // Complete: the frame is header + PDU, within the protocol's bounds, and
         // re-encodes to exactly the bytes it was read from (MBAP framing is bijective).
-        check(!frame.pdu.empty() && frame.pdu.size() <= protocol::mbap_max_length - 1u);
-        check(result.consumed == protocol::mbap_header_size + frame.pdu.size());
+        FB_FUZZ_CHECK(!frame.pdu.empty() && frame.pdu.size() <= protocol::mbap_max_length - 1u);
+        FB_FUZZ_CHECK(result.consumed == protocol::mbap_header_size + frame.pdu.size());
         const auto again = protocol::encode_mbap(frame.transaction_id, frame.unit_id, frame.pdu);
-        check(again.size() == result.consumed);
-        check(std::equal(again.begin(), again.end(), buffer.begin()));
+        FB_FUZZ_CHECK(again.size() == result.consumed);
+        FB_FUZZ_CHECK(std::equal(again.begin(), again.end(), buffer.begin()));
         out.frames.push_back(frame);
         buffer.erase(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(result.consumed));
     }
@@ -69,7 +68,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     Framed whole;
     protocol::Bytes all(stream.begin(), stream.end());
     drain(all, whole);
-    check(chunked.frames == whole.frames);
-    check(chunked.closed == whole.closed);
+    FB_FUZZ_CHECK(chunked.frames == whole.frames);
+    FB_FUZZ_CHECK(chunked.closed == whole.closed);
     return 0;
 }

@@ -15,7 +15,6 @@
 
 namespace {
 
-using fieldbridge::fuzz::check;
 namespace protocol = fieldbridge::protocol;
 
 /// Address + CRC around the PDU (Modbus over Serial Line V1.02, 2.5.1.1).
@@ -30,25 +29,25 @@ void drain(protocol::Bytes& buffer, std::uint8_t address, const protocol::Reques
         if (framed.need_more()) return;
         // Anything but need_more takes bytes off the buffer: consumed 0 would make the
         // line master scan the same bytes forever.
-        check(framed.consumed > 0 && framed.consumed <= buffer.size());
+        FB_FUZZ_CHECK(framed.consumed > 0 && framed.consumed <= buffer.size());
         if (framed.malformed()) {
-            check(framed.error != protocol::DecodeError::none);
+            FB_FUZZ_CHECK(framed.error != protocol::DecodeError::none);
         } else {
-            check(!broadcast);  // a broadcast is never answered
+            FB_FUZZ_CHECK(!broadcast);  // a broadcast is never answered
             const auto& frame = framed.value;
-            check(frame.address == address);
-            check(!frame.pdu.empty() && frame.pdu.size() <= protocol::max_pdu_size);
-            check(frame.pdu.size() + rtu_overhead <= framed.consumed);
+            FB_FUZZ_CHECK(frame.address == address);
+            FB_FUZZ_CHECK(!frame.pdu.empty() && frame.pdu.size() <= protocol::max_pdu_size);
+            FB_FUZZ_CHECK(frame.pdu.size() + rtu_overhead <= framed.consumed);
             // The frame is the last bytes consumed and re-encodes to them.
             const auto again = protocol::encode_rtu(frame.address, frame.pdu);
-            check(std::equal(again.begin(), again.end(),
+            FB_FUZZ_CHECK(std::equal(again.begin(), again.end(),
                              buffer.begin() + static_cast<std::ptrdiff_t>(framed.consumed - again.size())));
             const auto decoded = protocol::decode_response(frame.pdu, request);
             if (decoded.complete()) {
                 // Response PDUs are bijective: the decoded reply re-encodes to its bytes.
-                check(protocol::encode_response(decoded.value) == frame.pdu);
+                FB_FUZZ_CHECK(protocol::encode_response(decoded.value) == frame.pdu);
             } else {
-                check(decoded.malformed() && decoded.consumed == frame.pdu.size());
+                FB_FUZZ_CHECK(decoded.malformed() && decoded.consumed == frame.pdu.size());
             }
         }
         buffer.erase(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(framed.consumed));

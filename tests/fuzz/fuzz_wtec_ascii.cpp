@@ -17,7 +17,6 @@
 
 namespace {
 
-using fieldbridge::fuzz::check;
 namespace protocol = fieldbridge::protocol;
 namespace wtec = protocol::wtec;
 
@@ -60,26 +59,26 @@ wtec::Command command_of(std::uint8_t which, std::span<const std::uint8_t> p) {
 /// decoded as a reply or as a request, it survives a round trip through the encoder.
 void check_frame(const wtec::AsciiFrame& frame, protocol::ByteView frame_bytes, std::uint8_t address,
                  const wtec::Command& command) {
-    check(frame.data.size() <= wtec::max_data_size);
+    FB_FUZZ_CHECK(frame.data.size() <= wtec::max_data_size);
     const std::string text = wtec::encode_frame(frame);
-    check(text.size() == frame_bytes.size() && std::equal(text.begin(), text.end(), frame_bytes.begin()));
+    FB_FUZZ_CHECK(text.size() == frame_bytes.size() && std::equal(text.begin(), text.end(), frame_bytes.begin()));
 
     const auto reply = wtec::decode_reply(address, command, frame);
     if (reply.complete()) {
         // Encoded from the address that replied (for `$` any station, for `i` the new one).
         const auto reencoded = wtec::encode_reply(frame.address, command, reply.value);
         const auto again = wtec::decode_reply(address, command, reencoded);
-        check(again.complete() && again.value == reply.value);
+        FB_FUZZ_CHECK(again.complete() && again.value == reply.value);
     } else {
-        check(reply.malformed() && reply.error != protocol::DecodeError::none);
+        FB_FUZZ_CHECK(reply.malformed() && reply.error != protocol::DecodeError::none);
     }
 
     const auto request = wtec::decode_command(frame);
     if (request.complete()) {
         const auto again = wtec::decode_command(wtec::encode_command(frame.address, request.value));
-        check(again.complete() && again.value == request.value);
+        FB_FUZZ_CHECK(again.complete() && again.value == request.value);
     } else {
-        check(request.malformed() && request.error != protocol::DecodeError::none);
+        FB_FUZZ_CHECK(request.malformed() && request.error != protocol::DecodeError::none);
     }
 }
 
@@ -87,15 +86,15 @@ void drain(protocol::Bytes& buffer, std::uint8_t address, const wtec::Command& c
     while (!buffer.empty()) {
         const auto scanned = wtec::scan_frame(buffer);
         if (scanned.need_more()) {
-            check(scanned.consumed == 0);
+            FB_FUZZ_CHECK(scanned.consumed == 0);
             return;
         }
-        check(scanned.consumed > 0 && scanned.consumed <= buffer.size());
+        FB_FUZZ_CHECK(scanned.consumed > 0 && scanned.consumed <= buffer.size());
         if (scanned.malformed()) {
-            check(scanned.error != protocol::DecodeError::none);
+            FB_FUZZ_CHECK(scanned.error != protocol::DecodeError::none);
         } else {
             const std::size_t frame_size = wtec::frame_overhead + scanned.value.data.size();
-            check(frame_size <= scanned.consumed && frame_size <= wtec::max_frame_size);
+            FB_FUZZ_CHECK(frame_size <= scanned.consumed && frame_size <= wtec::max_frame_size);
             check_frame(scanned.value, protocol::ByteView(buffer).subspan(scanned.consumed - frame_size, frame_size),
                         address, command);
         }
