@@ -11,8 +11,7 @@ using engine::LogLevel;
 ReconnectSchedule::ReconnectSchedule(asio::io_context& io, ReconnectSettings settings,
                                      std::unique_ptr<BrokerProbe> probe, std::function<void()> connect,
                                      engine::LogSink log)
-    : io_(io),
-      s_(settings),
+    : s_(settings),
       probe_(std::move(probe)),
       connect_(std::move(connect)),
       log_(std::move(log)),

@@ -54,7 +54,6 @@ private:
     void on_probe(bool reachable);
     void connect_now();
 
-    asio::io_context& io_;
     ReconnectSettings s_;
     std::unique_ptr<BrokerProbe> probe_;
     std::function<void()> connect_;
