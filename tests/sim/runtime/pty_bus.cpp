@@ -22,6 +22,7 @@ PtyBus::~PtyBus() { close(); }
 
 void PtyBus::open() {
     port_ = std::make_unique<PtyPort>(io_, link_);
+    watch_opens();
     closed_ = false;
     log_->info("{}: {} -> {} ({} device(s), {} bps, wire time {})", name(), link_.string(),
                port_->slave_name(), engine_->stats(Clock::now())["devices"].size(),
@@ -38,6 +39,7 @@ void PtyBus::close() {
     output_armed_.reset();
     resync_armed_.reset();
     if (port_) {
+        unwatch_opens();
         port_.reset();
         log_->info("{}: closed, {} removed", name(), link_.string());
     }
@@ -53,6 +55,7 @@ void PtyBus::unplug(std::chrono::nanoseconds downtime) {
     resync_timer_.cancel();
     output_armed_.reset();
     resync_armed_.reset();
+    unwatch_opens();
     port_.reset();
     log_->warn("{}: unplugged: pty closed and {} removed for {}", name(), link_.string(),
                format_duration(downtime));
@@ -66,6 +69,7 @@ void PtyBus::on_replug_timer(const asio::error_code& error) {
     }
     try {
         port_ = std::make_unique<PtyPort>(io_, link_);
+        watch_opens();
         log_->warn("{}: plugged back in: {} -> {}", name(), link_.string(), port_->slave_name());
         start_read();
     } catch (const std::exception& e) {
@@ -91,7 +95,27 @@ nlohmann::json PtyBus::stats(Clock::time_point now) const {
     json["path"] = link_.string();
     json["pty"] = port_ ? nlohmann::json(port_->slave_name()) : nlohmann::json(nullptr);
     json["connected"] = port_ != nullptr;
+    // Opens of the line's port by the gateway since the simulator started (a reopen
+    // after a failure or a restart of the line counts one more).
+    json["port_opens"] = opens_before_ + (opens_watch_ ? opens_watch_->opens() : 0);
+    json["port_closes"] = closes_before_ + (opens_watch_ ? opens_watch_->closes() : 0);
     return json;
+}
+
+void PtyBus::watch_opens() {
+    try {
+        opens_watch_ = std::make_unique<PtyOpenWatch>(io_, port_->slave_name());
+    } catch (const std::exception& e) {
+        // The bus works without it; only the `port_opens` count stays still.
+        log_->warn("{}: {}", name(), e.what());
+    }
+}
+
+void PtyBus::unwatch_opens() {
+    if (!opens_watch_) return;
+    opens_before_ += opens_watch_->opens();
+    closes_before_ += opens_watch_->closes();
+    opens_watch_.reset();
 }
 
 void PtyBus::start_read() {

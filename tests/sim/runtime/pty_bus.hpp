@@ -18,6 +18,7 @@
 #include <spdlog/logger.h>
 
 #include "bus_engine.hpp"
+#include "pty_open_watch.hpp"
 #include "pty_port.hpp"
 
 namespace fieldbridge::sim::runtime {
@@ -55,6 +56,10 @@ public:
 
 private:
     void start_read();
+    /// A new pty: watch its slave for the gateway's opens.
+    void watch_opens();
+    /// The pty goes: keep its counts.
+    void unwatch_opens();
     void on_read(const asio::error_code& error, std::size_t count);
     void flush_due();
     void arm_timers();
@@ -67,6 +72,10 @@ private:
     std::unique_ptr<BusEngine> engine_;
     std::shared_ptr<spdlog::logger> log_;
     std::unique_ptr<PtyPort> port_;
+    /// Opens and closes of the current pty's slave by the gateway (replug: a new watch).
+    std::unique_ptr<PtyOpenWatch> opens_watch_;
+    std::uint64_t opens_before_ = 0;   ///< of earlier ptys (before an unplug)
+    std::uint64_t closes_before_ = 0;
     asio::steady_timer output_timer_;
     asio::steady_timer resync_timer_;
     asio::steady_timer replug_timer_;
