@@ -23,9 +23,19 @@ public:
     Reloadable& operator=(Reloadable&&) = delete;
     virtual ~Reloadable() = default;
 
+    /// Reload, first phase, on every component before any apply(): takes what the new
+    /// configuration needs and may fail to get (a new listen address), without
+    /// changing what runs. Throws (saying what failed and what to do) to reject the
+    /// whole reload: the daemon then calls abandon() on the components prepared so
+    /// far and keeps the running configuration. Default: nothing to take.
+    virtual void prepare(const config::Config& /*next*/) {}
+    /// The reload was rejected after prepare(): release what it took.
+    virtual void abandon() noexcept {}
+
     /// Switches to @p config; keeps running what did not change (spec section 7).
-    /// Must not throw for a configuration the loader accepted: an exception is
-    /// logged as an error naming the component, and the others still get it.
+    /// Must not throw for a configuration the loader accepted and every component
+    /// prepared: an exception is logged as an error naming the component, and the
+    /// others still get it.
     virtual void apply(std::shared_ptr<const config::Config> config) = 0;
 };
 

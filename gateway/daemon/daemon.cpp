@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <csignal>
 #include <exception>
+#include <thread>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -70,7 +71,10 @@ Daemon::Daemon(DaemonOptions options, std::shared_ptr<const config::Config> init
     status_.add([this] { return describe_inventory(*config_); });
 }
 
-Daemon::~Daemon() = default;
+Daemon::~Daemon() {
+    // A reload still reading the file: its result is dropped with the loop.
+    if (loading_.joinable()) loading_.join();
+}
 
 void Daemon::add_component(Component& component) {
     if (ran_) {
@@ -185,42 +189,95 @@ void Daemon::request_reload() {
 }
 
 void Daemon::reload() {
+    if (loading_.joinable()) {
+        // A reload is being read: read the file once more when it is done (the newest
+        // file wins; two readers would race).
+        reload_again_ = true;
+        return;
+    }
     notify(reloading_message());
+    logger_->debug("re-reading {}", options_.config_file.string());
+    // The file is read and validated off the loop, so the lines, TCP clients and MQTT
+    // keep running meanwhile; only the difference is applied on the loop (finish_reload).
+    loading_ = std::thread([this, file = options_.config_file] {
+        std::shared_ptr<const config::Config> next;
+        std::exception_ptr error;
+        try {
+            next = load_(file);
+        } catch (...) {
+            error = std::current_exception();
+        }
+        asio::post(io_, [this, next = std::move(next), error]() mutable { finish_reload(std::move(next), error); });
+    });
+}
+
+void Daemon::finish_reload(std::shared_ptr<const config::Config> next, std::exception_ptr error) {
+    if (loading_.joinable()) loading_.join();
+    if (phase_ != Phase::running) {
+        logger_->info("reload abandoned: the gateway is stopping");
+        return;
+    }
     const auto& file = options_.config_file;
-    std::shared_ptr<const config::Config> next;
-    logger_->debug("re-reading {}", file.string());
     try {
-        next = load_(file);
-    } catch (const config::ConfigError& error) {
-        for (const auto& diagnostic : error.diagnostics()) {
+        if (error) std::rethrow_exception(error);
+    } catch (const config::ConfigError& rejected) {
+        for (const auto& diagnostic : rejected.diagnostics()) {
             logger_->error("{}", diagnostic.to_string());
         }
         logger_->error("configuration reload rejected: {} in {}; the gateway keeps running with the previous "
                        "configuration; fix the file and reload again",
-                       count_of(error.diagnostics().size(), "problem", "problems"), file.string());
+                       count_of(rejected.diagnostics().size(), "problem", "problems"), file.string());
         last_reload_rejected_ = true;
-    } catch (const std::exception& error) {
+        rejection_.clear();
+        next.reset();
+    } catch (const std::exception& failed) {
         logger_->error("configuration reload failed: {}: {}; the gateway keeps running with the previous "
                        "configuration",
-                       file.string(), error.what());
+                       file.string(), failed.what());
         last_reload_rejected_ = true;
+        rejection_.clear();
+        next.reset();
     }
-    if (next) {
+    if (next && prepare(*next)) {
         config_ = std::move(next);
         last_reload_rejected_ = false;
+        rejection_.clear();
         apply_log_level();
         for (auto* component : components_) {
             try {
                 component->apply(config_);
-            } catch (const std::exception& error) {
+            } catch (const std::exception& failed) {
                 logger_->error("{} could not apply the new configuration: {}; it may still run with parts of the "
                                "previous one; restart the service to be sure",
-                               component->name(), error.what());
+                               component->name(), failed.what());
             }
         }
         logger_->info("configuration reloaded from {} ({})", file.string(), describe_config(*config_));
     }
     notify("READY=1\nSTATUS=" + status_.take_if_changed(true).value_or(""));
+    if (reload_again_) {
+        reload_again_ = false;
+        reload();
+    }
+}
+
+bool Daemon::prepare(const config::Config& next) {
+    std::size_t prepared = 0;
+    for (; prepared < started_; ++prepared) {
+        auto* component = components_[prepared];
+        try {
+            component->prepare(next);
+        } catch (const std::exception& error) {
+            for (auto i = prepared; i > 0; --i) components_[i - 1]->abandon();
+            rejection_ = error.what();
+            last_reload_rejected_ = true;
+            logger_->error("configuration reload rejected: {} cannot apply it: {}; the gateway keeps running with "
+                           "the previous configuration; fix {} and reload again",
+                           component->name(), rejection_, options_.config_file.string());
+            return false;
+        }
+    }
+    return true;
 }
 
 void Daemon::request_stop(const std::string& reason) {
@@ -326,7 +383,13 @@ std::string Daemon::phase_note() const {
         case Phase::running:
             break;
     }
-    return last_reload_rejected_ ? "last reload rejected (see the log)" : "";
+    if (!last_reload_rejected_) return "";
+    if (rejection_.empty()) return "last reload rejected (see the log)";
+    // STATUS= is one line: the reason's first line, cut to what `systemctl status` shows.
+    constexpr std::size_t shown = 100;
+    std::string reason = rejection_.substr(0, rejection_.find('\n'));
+    if (reason.size() > shown) reason = reason.substr(0, shown - 3) + "...";
+    return "last reload rejected: " + reason;
 }
 
 }  // namespace fieldbridge::daemon

@@ -21,10 +21,12 @@
 // header was read; two choices in one program are an ODR violation (ASan:
 // alloc-dealloc-mismatch).
 #include <chrono>
+#include <exception>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <asio/io_context.hpp>
@@ -104,7 +106,14 @@ private:
     void on_signal(int signal_number);
     void start_components();
     void on_ready();
+    /// Starts reading the file on a thread of its own (the loop keeps running).
     void reload();
+    /// On the loop once the file is read: rejects it, or prepares and applies it.
+    void finish_reload(std::shared_ptr<const config::Config> next, std::exception_ptr error);
+    /// Reload, first phase: every started component prepares @p next; when one
+    /// cannot, the prepared ones abandon, the rejection is logged and kept for
+    /// STATUS=, and false is returned.
+    [[nodiscard]] bool prepare(const config::Config& next);
     void finish();
     /// Sends @p state to the service manager, logged at debug level (pings excepted).
     void notify(const std::string& state);
@@ -133,7 +142,10 @@ private:
     Phase phase_ = Phase::starting;
     bool ran_ = false;
     bool reload_pending_ = false;
+    std::thread loading_;        ///< reads the file of a reload in progress
+    bool reload_again_ = false;  ///< SIGHUP while reading: read once more afterwards
     bool last_reload_rejected_ = false;
+    std::string rejection_;  ///< why the last reload was rejected, when a component refused it
     int exit_code_ = 0;
 };
 

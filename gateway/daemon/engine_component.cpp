@@ -55,14 +55,16 @@ void EngineComponent::start(StartContext& context) {
 void EngineComponent::stop(StopContext& /*context*/) { tear_down(); }
 
 void EngineComponent::apply(std::shared_ptr<const config::Config> config) {
-    if (config_ && config_->lines == config->lines) {
+    if (!engine_ || (config_ && config_->lines == config->lines)) {
         config_ = std::move(config);
         return;
     }
-    logger_->info("line engine: lines or devices changed; reopening the lines (queued requests are cancelled)");
-    tear_down();
     config_ = std::move(config);
-    build(*config_);
+    // Only what changed: unchanged lines keep their ports, queues and the transaction
+    // in flight (engine/engine.hpp). Listeners re-take their pointers afterwards.
+    const auto report = engine_->apply(*config_);
+    logger_->info("line engine: reload applied: {}; {}", report.summary(), engine_->status());
+    notify(engine_.get());
 }
 
 std::string EngineComponent::status() const { return engine_ ? engine_->status() : std::string("engine stopped"); }

@@ -1,8 +1,8 @@
 #pragma once
 /// @file engine_component.hpp
-/// The line engine as a daemon component: built from the configuration at start,
-/// rebuilt on a reload that changes lines or devices (their ports are closed and
-/// reopened, queued requests complete `cancelled`), left alone otherwise.
+/// The line engine as a daemon component: built from the configuration at start; a
+/// reload that changes lines or devices applies only the difference
+/// (engine::Engine::apply(): unchanged lines keep running), left alone otherwise.
 #include <asio/io_context.hpp>
 #include <memory>
 #include <spdlog/logger.h>
@@ -33,9 +33,10 @@ public:
     /// Nullptr before start() and after stop().
     [[nodiscard]] engine::Engine* engine() const noexcept { return engine_.get(); }
 
-    /// Called with nullptr just before the engine is destroyed (stop, or a reload that
-    /// rebuilds it) and with the new engine once it runs: whoever holds pointers into
-    /// the engine (routes, MQTT sources) drops and re-takes them here.
+    /// Called with nullptr just before the engine is destroyed (stop), with the engine
+    /// once it runs, and again with it after a reload changed its lines or devices:
+    /// whoever holds pointers into the engine (routes, MQTT sources) drops and
+    /// re-takes them here (objects a reload replaced stay valid until the next reload).
     using ChangeListener = std::function<void(engine::Engine*)>;
     void on_change(ChangeListener listener) { listeners_.push_back(std::move(listener)); }
     /// For STATUS=.

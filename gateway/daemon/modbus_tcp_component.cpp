@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <map>
+
 namespace fieldbridge::daemon {
 
 namespace {
@@ -47,24 +49,39 @@ void ModbusTcpComponent::stop_upstreams() {
 void ModbusTcpComponent::rebuild_routes(engine::Engine* engine) {
     auto& routes = server_->routes();
     routes.clear();
-    serial_targets_.clear();
+    // A line the reload left alone keeps its targets: a broadcast target holds the
+    // line's budget and its writes in flight (destroying it answers those 0x0A).
+    std::map<std::string, LineTargets, std::less<>> next;
     if (engine != nullptr) {
         for (const auto& line : engine->lines()) {
+            const std::string& name = line.worker->config().name;
+            if (const auto old = line_targets_.find(name); old != line_targets_.end() &&
+                                                           old->second.worker == line.worker.get() &&
+                                                           old->second.revision == line.revision) {
+                next.emplace(name, std::move(old->second));
+                continue;
+            }
+            LineTargets built{line.worker.get(), line.revision, {}, {}};
             std::vector<northbound::LineUnit> units;
             for (const auto& device : engine->devices()) {
-                if (device.line != line.worker->config().name) continue;
-                serial_targets_.push_back(
+                if (device.line != name) continue;
+                built.targets.push_back(
                     std::make_unique<northbound::SerialDeviceTarget>(io_, *device.agent, *line.worker));
-                routes.set(device.unit_id, *serial_targets_.back());
+                built.units.push_back(device.unit_id);
                 units.push_back(northbound::LineUnit{device.agent, device.unit_id});
             }
             if (line.broadcast_unit) {
-                serial_targets_.push_back(std::make_unique<northbound::LineBroadcastTarget>(
+                built.targets.push_back(std::make_unique<northbound::LineBroadcastTarget>(
                     io_, *line.worker, std::move(units),
                     northbound::BroadcastSettings{line.broadcast_ttl, line.broadcast_share}));
-                routes.set(*line.broadcast_unit, *serial_targets_.back());
+                built.units.push_back(*line.broadcast_unit);
             }
+            next.emplace(name, std::move(built));
         }
+    }
+    line_targets_ = std::move(next);
+    for (const auto& [name, line] : line_targets_) {
+        for (std::size_t t = 0; t < line.targets.size(); ++t) routes.set(line.units[t], *line.targets[t]);
     }
     for (std::size_t u = 0; u < upstreams_.size(); ++u) {
         for (const auto& unit : config_->upstreams.at(u).units) routes.set(unit.unit_id, *upstreams_[u]);
@@ -89,9 +106,17 @@ void ModbusTcpComponent::stop(StopContext& /*context*/) {
         server_->stop();
         server_->routes().clear();
     }
-    serial_targets_.clear();
+    line_targets_.clear();
     stop_upstreams();
     server_.reset();
+}
+
+void ModbusTcpComponent::prepare(const config::Config& next) {
+    if (server_) server_->prepare(next.modbus_tcp);
+}
+
+void ModbusTcpComponent::abandon() noexcept {
+    if (server_) server_->abandon_prepared();
 }
 
 void ModbusTcpComponent::apply(std::shared_ptr<const config::Config> config) {

@@ -5,7 +5,9 @@
 /// devices of the engine, lines' broadcast units, upstream units). Routes follow the
 /// engine: they are dropped before it is rebuilt and set again from the new one.
 #include <asio/io_context.hpp>
+#include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <spdlog/logger.h>
 #include <string>
@@ -32,6 +34,9 @@ public:
     [[nodiscard]] std::string name() const override { return "Modbus TCP server"; }
     void start(StartContext& context) override;
     void stop(StopContext& context) override;
+    /// Binds new listen addresses (a reload that cannot is rejected as a whole).
+    void prepare(const config::Config& next) override;
+    void abandon() noexcept override;
     void apply(std::shared_ptr<const config::Config> config) override;
 
     /// The upstream targets, one per configured upstream (for the MQTT R6 sources).
@@ -58,7 +63,15 @@ private:
     std::shared_ptr<const config::Config> config_;
     std::unique_ptr<northbound::modbus_tcp::ModbusTcpServer> server_;
     std::vector<std::unique_ptr<northbound::upstream::UpstreamTarget>> upstreams_;
-    std::vector<std::unique_ptr<northbound::UnitTarget>> serial_targets_;
+    /// The targets of one line (its devices, then its broadcast unit) and the unit of
+    /// each, with the line's worker and revision they were built for.
+    struct LineTargets {
+        const engine::LineWorker* worker = nullptr;
+        std::uint64_t revision = 0;
+        std::vector<std::unique_ptr<northbound::UnitTarget>> targets;
+        std::vector<std::uint8_t> units;
+    };
+    std::map<std::string, LineTargets, std::less<>> line_targets_;  ///< by line name
     std::vector<std::function<void()>> upstreams_closing_;
     std::vector<northbound::modbus_tcp::InheritedListener> inherited_;  ///< until start() hands them over
 };

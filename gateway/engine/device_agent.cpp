@@ -41,6 +41,7 @@ void DeviceAgent::request(const protocol::Request& request, ResponseHandler done
     impl_->request(request, std::move(done));
 }
 void DeviceAgent::broadcast_written(const protocol::Request& request) { impl_->broadcast_written(request); }
+void DeviceAgent::retune(const DeviceAgentConfig& config) { impl_->retune(config); }
 void DeviceAgent::on_health(bool online, TimePoint now) { impl_->on_health(online, now); }
 void DeviceAgent::set_notice_callback(NoticeCallback callback) { impl_->set_notice_callback(std::move(callback)); }
 RegisterImage& DeviceAgent::image() noexcept { return impl_->image(); }

@@ -87,6 +87,11 @@ public:
     void start();
     void stop();
 
+    /// Reload: new freshness and command timing (max_age, command_ttl,
+    /// delay_before_command of @p config; every other field must be unchanged) apply
+    /// from the next request on; the image, the poll plan and requests in flight stay.
+    void retune(const DeviceAgentConfig& config);
+
     /// A northbound request (PDU decoded): @p done is called exactly once, on the loop
     /// thread, never from inside request(), with the response (normal or exception).
     void request(const protocol::Request& request, ResponseHandler done);

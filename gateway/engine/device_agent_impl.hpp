@@ -40,6 +40,11 @@ public:
     void broadcast_written(const protocol::Request& request);
     void on_health(bool online, TimePoint now);
     void set_notice_callback(NoticeCallback callback) { notice_ = std::move(callback); }
+    void retune(const DeviceAgentConfig& config) {
+        config_.max_age = config.max_age;
+        config_.command_ttl = config.command_ttl;
+        config_.delay_before_command = config.delay_before_command;
+    }
 
     RegisterImage& image() noexcept { return image_; }
     [[nodiscard]] const RegisterImage& image() const noexcept { return image_; }

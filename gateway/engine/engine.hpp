@@ -5,8 +5,10 @@
 /// worker, the line's health and port state reach the agents. Northbound servers find
 /// devices here by Modbus unit ID or by name.
 ///
-/// Loop thread only. The engine is rebuilt, not patched, when the lines or devices of
-/// the configuration change (daemon/engine_component.hpp).
+/// Loop thread only. A reload applies the difference (apply()): a line whose settings
+/// and devices did not change keeps its worker, port, queue and transaction in flight;
+/// a device whose profile settings changed is swapped on a line that keeps running; a
+/// line whose serial or timing settings changed restarts (docs/architecture.md, "Reload").
 #include <asio/io_context.hpp>
 #include <functional>
 #include <memory>
@@ -39,13 +41,41 @@ struct DeviceEntry {
 /// One line and its devices.
 struct LineEntry {
     std::unique_ptr<LineWorker> worker;
-    std::vector<std::unique_ptr<DeviceAgent>> agents;  ///< by DeviceIndex
+    /// In configuration order; each agent's config().index is its scheduler index
+    /// (indices are not reused within a line: a swapped device gets a new one).
+    std::vector<std::unique_ptr<DeviceAgent>> agents;
     std::optional<std::uint8_t> broadcast_unit;
     /// The line's shortest command_ttl: a broadcast acts no later than any of its
     /// devices would accept a command.
     Duration broadcast_ttl = std::chrono::milliseconds{500};
     /// Percent of the line's time its broadcasts may take (config broadcast_share).
     unsigned broadcast_share = 10;
+    /// Changes whenever a reload replaced the worker or any agent of this line:
+    /// whoever keeps objects built on them (Modbus TCP targets) rebuilds those then.
+    std::uint64_t revision = 0;
+    /// What the line was built from (compared on reload).
+    config::LineConfig config;
+    /// Agents replaced by a reload: stopped, kept until the next reload so that their
+    /// requests still queued on the line complete normally (never cancelled).
+    std::vector<std::unique_ptr<DeviceAgent>> retired;
+    DeviceIndex next_index = 0;
+};
+
+/// What a reload did, line by line and device by device (for the log and tests).
+struct ReloadReport {
+    std::vector<std::string> lines_kept;       ///< untouched: port, queue, in-flight transaction
+    std::vector<std::string> lines_updated;    ///< devices or line policies changed; port stays open
+    std::vector<std::string> lines_restarted;  ///< serial or timing settings changed: port reopened
+    std::vector<std::string> lines_added;
+    std::vector<std::string> lines_removed;
+    std::vector<std::string> devices_retuned;   ///< freshness/command timing/limits in place
+    std::vector<std::string> devices_replaced;  ///< new profile settings: a new agent, same port
+    std::vector<std::string> devices_added;
+    std::vector<std::string> devices_removed;
+
+    [[nodiscard]] bool changed() const noexcept;
+    /// "lines kept: a; restarted: b; devices retuned: x" (empty parts left out).
+    [[nodiscard]] std::string summary() const;
 };
 
 class Engine {
@@ -63,6 +93,11 @@ public:
     /// Stops polling, completes everything queued `cancelled`, closes the ports.
     void stop();
 
+    /// Reload (after start()): brings the engine to @p config, touching only what
+    /// changed (see the file comment). Throws like the constructor for a line or
+    /// device it cannot build; lines already handled stay as applied.
+    ReloadReport apply(const config::Config& config);
+
     /// By Modbus TCP unit ID; nullptr when no serial device has it.
     [[nodiscard]] DeviceAgent* find_unit(std::uint8_t unit_id) const noexcept;
     /// By configured device name; nullptr when unknown.
@@ -74,7 +109,22 @@ public:
     [[nodiscard]] std::string status() const;
 
 private:
+    [[nodiscard]] LineEntry build_line(const config::LineConfig& line);
+    [[nodiscard]] std::unique_ptr<DeviceAgent> build_agent(LineEntry& entry, const config::LineConfig& line,
+                                                           const config::DeviceConfig& device);
+    /// Health and port state of the worker reach the line's current agents.
+    static void wire_health(LineEntry& entry);
+    static void set_broadcast(LineEntry& entry, const config::LineConfig& line);
+    /// A line with the same serial and timing settings: devices and policies in place.
+    void update_line(LineEntry& entry, const config::LineConfig& line, ReloadReport& report);
+    void index_devices();
+
+    asio::io_context& io_;
+    PortFactory ports_;
     std::vector<LineEntry> lines_;
+    /// Lines a reload stopped (removed or restarted): their ports are closed; they are
+    /// destroyed at the next reload, once nothing refers to their agents any more.
+    std::vector<LineEntry> retired_lines_;
     std::vector<DeviceEntry> devices_;
     LogSink log_;
     bool started_ = false;

@@ -56,12 +56,11 @@ struct LineScheduler::Rank {
 LineScheduler::LineScheduler(SchedulerConfig config, LogSink log)
     : config_(std::move(config)), log_(std::move(log)) {}
 
-void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits, std::string name) {
+void LineScheduler::check_limits(DeviceIndex device, const DeviceLimits& limits) const {
     const std::string where = "line " + config_.line_name + " device " + std::to_string(device);
     if (device == broadcast_device) {
         throw std::invalid_argument(where + ": index is reserved for broadcasts");
     }
-    if (devices_.count(device) != 0) throw std::invalid_argument(where + ": added twice");
     if (limits.queue_limit == 0) throw std::invalid_argument(where + ": queue_limit must be at least 1");
     if (limits.offline_after == 0) {
         throw std::invalid_argument(where + ": offline_after must be at least 1 timeout");
@@ -69,11 +68,40 @@ void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits, std::str
     if (limits.backoff_initial <= Duration::zero() || limits.backoff_max < limits.backoff_initial) {
         throw std::invalid_argument(where + ": offline back-off needs 0 < initial <= max");
     }
+}
+
+void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits, std::string name) {
+    check_limits(device, limits);
+    if (devices_.count(device) != 0) {
+        throw std::invalid_argument("line " + config_.line_name + " device " + std::to_string(device) +
+                                    ": added twice");
+    }
     Device state;
     state.limits = limits;
     state.name = std::move(name);
     state.backoff = limits.backoff_initial;
     devices_.emplace(device, std::move(state));
+}
+
+void LineScheduler::update_device(DeviceIndex device, DeviceLimits limits) {
+    check_limits(device, limits);
+    Device* known = find(device);
+    if (known == nullptr) {
+        throw std::invalid_argument("line " + config_.line_name + " device " + std::to_string(device) +
+                                    ": cannot update a device that was never added");
+    }
+    known->limits = limits;
+    // The current back-off stays inside the new bounds; the next step starts from them.
+    known->backoff = std::clamp(known->backoff, limits.backoff_initial, limits.backoff_max);
+}
+
+void LineScheduler::remove_device(DeviceIndex device, OutcomeStatus status, TimePoint now) {
+    const auto it = devices_.find(device);
+    if (it == devices_.end()) return;
+    Completions done;
+    for (Entry& entry : it->second.queue) reject(std::move(entry.transaction), status, now, done);
+    devices_.erase(it);
+    complete(done);
 }
 
 LineScheduler::Device* LineScheduler::find(DeviceIndex device) noexcept {

@@ -125,6 +125,13 @@ public:
     /// offline_after 0, back-off not positive or max below initial). @p name (the
     /// device's config name) is what the scheduler's log messages call it.
     void add_device(DeviceIndex device, DeviceLimits limits, std::string name = {});
+    /// Reload: new limits for a registered device (same checks as add_device); its
+    /// queue, health state and counters stay. Throws std::invalid_argument for an
+    /// unknown device.
+    void update_device(DeviceIndex device, DeviceLimits limits);
+    /// Reload: forgets @p device. Its queued transactions complete with @p status; one
+    /// in flight still completes through finished(). Unknown devices are ignored.
+    void remove_device(DeviceIndex device, OutcomeStatus status, TimePoint now);
     void set_health_callback(HealthCallback callback) { on_health_ = std::move(callback); }
 
     /// Queues @p transaction (sets id and enqueued), or completes it at once:
@@ -192,6 +199,7 @@ private:
     };
     using Completions = std::vector<Completion>;
 
+    void check_limits(DeviceIndex device, const DeviceLimits& limits) const;
     [[nodiscard]] Device* find(DeviceIndex device) noexcept;
     [[nodiscard]] const Device* find(DeviceIndex device) const noexcept;
     [[nodiscard]] bool eligible(const Device& device, TimePoint now) const noexcept;

@@ -67,14 +67,7 @@ std::vector<std::shared_ptr<ModbusTcpServer::Listener>> ModbusTcpServer::open_li
     const config::ModbusTcpConfig& config) {
     std::vector<std::shared_ptr<Listener>> opened;
     try {
-        for (const auto& address : config.listen) {
-            if (auto adopted = open_adopted(address)) {
-                opened.push_back(std::move(adopted));
-                continue;
-            }
-            auto acceptor = open_listen_socket(io_, address, address.is_ipv6() && shares_port_with_ipv4(config, address));
-            opened.push_back(std::make_shared<Listener>(*this, std::move(acceptor), address.to_string()));
-        }
+        for (const auto& address : config.listen) opened.push_back(open_listener(config, address));
     } catch (...) {
         for (auto& listener : opened) {
             listener->server = nullptr;
@@ -84,6 +77,73 @@ std::vector<std::shared_ptr<ModbusTcpServer::Listener>> ModbusTcpServer::open_li
         throw;
     }
     return opened;
+}
+
+std::shared_ptr<ModbusTcpServer::Listener> ModbusTcpServer::open_listener(const config::ModbusTcpConfig& config,
+                                                                          const config::ListenAddress& address) {
+    if (auto adopted = open_adopted(address)) return adopted;
+    auto acceptor = open_listen_socket(io_, address, address.is_ipv6() && shares_port_with_ipv4(config, address));
+    return std::make_shared<Listener>(*this, std::move(acceptor), address.to_string());
+}
+
+void ModbusTcpServer::switch_listeners(const config::ModbusTcpConfig& config) {
+    // Addresses still listed keep their sockets (and their pending accept); new ones
+    // come from prepare(); the others close first (a new address may need their port).
+    // Connections stay whatever their listener.
+    std::vector<std::shared_ptr<Listener>> kept(bound_.size());
+    for (std::size_t i = 0; i < bound_.size(); ++i) {
+        auto& listener = listeners_.at(i);
+        if (std::find(config.listen.begin(), config.listen.end(), bound_[i]) != config.listen.end()) {
+            kept[i] = listener;
+            continue;
+        }
+        log(context_->log, LogLevel::info, "Modbus TCP: no longer listening on {}", listener->name);
+        listener->server = nullptr;
+        asio::error_code ignored;
+        listener->acceptor.close(ignored);
+        listener->retry.cancel();
+    }
+    std::vector<std::shared_ptr<Listener>> next;
+    std::vector<config::ListenAddress> bound;
+    std::vector<std::shared_ptr<Listener>> fresh;
+    for (const auto& address : config.listen) {
+        if (const auto old = std::find(bound_.begin(), bound_.end(), address); old != bound_.end()) {
+            next.push_back(kept.at(static_cast<std::size_t>(old - bound_.begin())));
+            bound.push_back(address);
+            continue;
+        }
+        const auto ready = std::find_if(prepared_.begin(), prepared_.end(),
+                                        [&address](const auto& entry) { return entry.first == address; });
+        std::shared_ptr<Listener> listener = ready != prepared_.end() ? ready->second : nullptr;
+        if (!listener) {
+            try {
+                listener = open_listener(config, address);
+            } catch (const ModbusTcpError& e) {
+                log(context_->log, LogLevel::error,
+                    "{}; the Modbus TCP server does not listen there; fix modbus_tcp.listen and reload", e.what());
+                continue;
+            }
+        }
+        next.push_back(listener);
+        bound.push_back(address);
+        fresh.push_back(std::move(listener));
+    }
+    prepared_.clear();
+    listeners_ = std::move(next);
+    bound_ = std::move(bound);
+    for (const auto& listener : fresh) {
+        log(context_->log, LogLevel::info, "Modbus TCP: listening on {} (bound {})", listener->name,
+            to_string(listener->acceptor.local_endpoint()));
+        accept(listener);
+    }
+    for (const auto& adopted : adopted_) {
+        if (std::find(bound_.begin(), bound_.end(), adopted.address) != bound_.end()) continue;
+        log(context_->log, LogLevel::warning,
+            "Modbus TCP: no longer accepting on {}; its socket came from systemd and stays open, so clients "
+            "connecting there wait unanswered: remove it from the socket unit (ListenStream=) as well and "
+            "restart fieldbridge.socket and fieldbridge.service, or list it in modbus_tcp.listen again",
+            adopted.address.to_string());
+    }
 }
 
 std::shared_ptr<ModbusTcpServer::Listener> ModbusTcpServer::open_adopted(const config::ListenAddress& address) {
@@ -125,6 +185,7 @@ void ModbusTcpServer::close_listeners() {
 }
 
 void ModbusTcpServer::stop() {
+    abandon_prepared();
     close_listeners();
     // close() removes each connection from the map: close from a copy.
     std::vector<std::shared_ptr<Connection>> open;
@@ -217,34 +278,60 @@ void ModbusTcpServer::log_refusal(const std::string& message) {
     refusals_not_logged_ = 0;
 }
 
+void ModbusTcpServer::prepare(const config::ModbusTcpConfig& config) {
+    abandon_prepared();
+    if (!running() || config.listen == bound_) return;
+    try {
+        for (const auto& address : config.listen) {
+            if (std::find(bound_.begin(), bound_.end(), address) != bound_.end()) continue;
+            try {
+                prepared_.emplace_back(address, open_listener(config, address));
+            } catch (const ModbusTcpError&) {
+                // The port may be held by one of our own listeners that this change
+                // drops (0.0.0.0:502 -> 127.0.0.1:502): bind it once that one closed.
+                if (!frees_port(config, address.port)) throw;
+                prepared_.emplace_back(address, nullptr);
+            }
+        }
+    } catch (...) {
+        abandon_prepared();
+        throw;
+    }
+}
+
+bool ModbusTcpServer::frees_port(const config::ModbusTcpConfig& config, std::uint16_t port) const {
+    return std::any_of(bound_.begin(), bound_.end(), [&](const config::ListenAddress& held) {
+        return held.port == port && std::find(config.listen.begin(), config.listen.end(), held) == config.listen.end();
+    });
+}
+
+void ModbusTcpServer::abandon_prepared() noexcept {
+    for (auto& [address, listener] : prepared_) {
+        if (!listener) continue;
+        listener->server = nullptr;
+        asio::error_code ignored;
+        listener->acceptor.close(ignored);
+    }
+    prepared_.clear();
+}
+
 void ModbusTcpServer::apply(std::shared_ptr<const config::ModbusTcpConfig> config) {
     context_->config = std::move(config);
     const config::ModbusTcpConfig& now = *context_->config;
     if (running() && now.listen != bound_) {
-        // Close first: the new set may reuse a port of the old one.
-        close_listeners();
-        try {
-            listeners_ = open_listeners(now);
-            bound_ = now.listen;
-            for (const auto& adopted : adopted_) {
-                if (std::find(bound_.begin(), bound_.end(), adopted.address) != bound_.end()) continue;
-                log(context_->log, LogLevel::warning,
-                    "Modbus TCP: no longer accepting on {}; its socket came from systemd and stays open, so clients "
-                    "connecting there wait unanswered: remove it from the socket unit (ListenStream=) as well and "
-                    "restart fieldbridge.socket and fieldbridge.service, or list it in modbus_tcp.listen again",
-                    adopted.address.to_string());
-            }
-        } catch (const ModbusTcpError& e) {
-            log(context_->log, LogLevel::error, "{}; keeping the previous listen addresses", e.what());
-            config::ModbusTcpConfig old = now;
-            old.listen = bound_;
+        if (prepared_.empty()) {
+            // Not prepared by the daemon's first phase (tests, direct use): bind now.
             try {
-                listeners_ = open_listeners(old);
-            } catch (const ModbusTcpError& again) {
-                log(context_->log, LogLevel::error, "{}; the Modbus TCP server accepts no connections", again.what());
+                prepare(now);
+            } catch (const ModbusTcpError& e) {
+                log(context_->log, LogLevel::error, "{}; keeping the previous listen addresses", e.what());
             }
         }
-        start_accepting();
+        if (!prepared_.empty() || std::all_of(now.listen.begin(), now.listen.end(), [this](const auto& address) {
+                return std::find(bound_.begin(), bound_.end(), address) != bound_.end();
+            })) {
+            switch_listeners(now);
+        }
     }
     std::vector<std::shared_ptr<Connection>> refused;
     for (auto& [id, connection] : connections_) {

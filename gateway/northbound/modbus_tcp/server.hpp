@@ -24,6 +24,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "config/config.hpp"
@@ -58,10 +59,18 @@ public:
     void start();
     /// Stops accepting and closes every connection. Idempotent; start() may follow.
     void stop();
+    /// Reload, first phase: binds the addresses of @p config not listened on yet
+    /// (held, not accepting yet). Throws ModbusTcpError, with nothing changed, when
+    /// one cannot be bound: the daemon then rejects the whole reload.
+    void prepare(const config::ModbusTcpConfig& config);
+    /// Closes what prepare() bound (the reload was rejected). Idempotent.
+    void abandon_prepared() noexcept;
     /// Reload: new access rules, allow-list, limits and idle timeout apply at once
     /// (open connections of clients no longer allowed are closed; connections
-    /// beyond a lowered max_connections stay). Changed listen addresses are rebound;
-    /// when that fails the error is logged and the previous addresses are kept.
+    /// beyond a lowered max_connections stay). Listen addresses still listed keep
+    /// their sockets; new ones start accepting (bound by prepare(), or here when it
+    /// was not called: when that fails the error is logged and the previous
+    /// addresses are kept); dropped ones close. Open connections always stay.
     void apply(std::shared_ptr<const config::ModbusTcpConfig> config);
 
     /// Unit ID -> target. Targets must outlive their routes.
@@ -81,6 +90,14 @@ private:
     [[nodiscard]] std::vector<std::shared_ptr<Listener>> open_listeners(const config::ModbusTcpConfig& config);
     /// A duplicate of the adopted socket for @p address; nullptr when none was adopted.
     [[nodiscard]] std::shared_ptr<Listener> open_adopted(const config::ListenAddress& address);
+    /// The adopted socket for @p address, or a new bound one. Throws ModbusTcpError.
+    [[nodiscard]] std::shared_ptr<Listener> open_listener(const config::ModbusTcpConfig& config,
+                                                          const config::ListenAddress& address);
+    /// True when a listener on @p port is held now and @p config drops it.
+    [[nodiscard]] bool frees_port(const config::ModbusTcpConfig& config, std::uint16_t port) const;
+    /// apply()'s listener change, once every new address is in prepared_ (null: to
+    /// bind once the dropped listeners closed).
+    void switch_listeners(const config::ModbusTcpConfig& config);
     void start_accepting();
     void close_listeners();
     void accept(const std::shared_ptr<Listener>& listener);
@@ -92,6 +109,8 @@ private:
     std::shared_ptr<ConnectionContext> context_;
     std::vector<std::shared_ptr<Listener>> listeners_;
     std::vector<config::ListenAddress> bound_;  ///< what listeners_ were opened for
+    /// Bound by prepare() for the next apply(), not accepting yet.
+    std::vector<std::pair<config::ListenAddress, std::shared_ptr<Listener>>> prepared_;
     /// Adopted sockets; listeners_ serve duplicates of them, so closing a listener
     /// (stop, reload) never closes the socket systemd passed.
     std::vector<InheritedListener> adopted_;

@@ -3,6 +3,7 @@ stays; a valid one is taken."""
 
 import os
 import signal
+import socket
 import unittest
 
 import daemon_harness as h
@@ -40,6 +41,39 @@ class Reload(h.DaemonTestCase, unittest.TestCase):
 
         gateway.send(signal.SIGTERM)
         notify.wait_for_prefix("STOPPING=1")
+        self.assertEqual(gateway.wait_exit(), 0)
+
+    def test_a_listen_address_in_use_rejects_the_whole_reload(self):
+        notify = self.notify_socket()
+        path = self.config(h.CONFIG_ONE_LINE)
+        gateway = self.start(["--config", path], env=h.clean_environment({"NOTIFY_SOCKET": notify.path}))
+        notify.wait_for_prefix("READY=1")
+        port = h._PORT["port"]
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as blocker:
+            blocker.bind(("127.0.0.1", 0))
+            blocker.listen()
+            busy = blocker.getsockname()[1]
+            # A second line and a second listener whose port is taken: nothing of it applies.
+            h.write_file(self.tmp, os.path.basename(path), h.CONFIG_TWO_LINES.replace(
+                '["127.0.0.1:%d"]' % port, '["127.0.0.1:%d", "127.0.0.1:%d"]' % (port, busy)))
+            gateway.send(signal.SIGHUP)
+            notify.wait_for_prefix("RELOADING=1")
+            ready = notify.wait_for_prefix("READY=1")
+            self.assertTrue(ready.startswith("READY=1\nSTATUS=last reload rejected: Modbus TCP: cannot listen on "
+                                             "127.0.0.1:%d (bind failed: Address already in use)" % busy), ready)
+            self.assertIn(", 1 line, 2 devices, ", ready)
+            gateway.wait_for_log("configuration reload rejected: Modbus TCP server cannot apply it: Modbus TCP: "
+                                 "cannot listen on 127.0.0.1:%d" % busy)
+            socket.create_connection(("127.0.0.1", port), timeout=h.TIMEOUT).close()  # the old listener stays
+
+        # The port is free again: the same file is taken whole.
+        gateway.send(signal.SIGHUP)
+        notify.wait_for_prefix("RELOADING=1")
+        ready = notify.wait_for_prefix("READY=1")
+        self.assertTrue(ready.startswith("READY=1\nSTATUS=2 lines, 3 devices, "), ready)
+        gateway.wait_for_log("Modbus TCP: listening on 127.0.0.1:%d" % busy)
+        socket.create_connection(("127.0.0.1", busy), timeout=h.TIMEOUT).close()
+        gateway.send(signal.SIGTERM)
         self.assertEqual(gateway.wait_exit(), 0)
 
     def test_reload_with_the_file_gone(self):

@@ -102,6 +102,12 @@ public:
             finished = context.expect_finished(name_ + " transaction in flight");
         }
     }
+    /// Non-empty: prepare() refuses every reload with this reason.
+    std::string refuses_prepare;
+    void prepare(const config::Config& /*next*/) override {
+        if (!refuses_prepare.empty()) throw std::runtime_error(refuses_prepare);
+    }
+    void abandon() noexcept override { events_.push_back("abandon " + name_); }
     void apply(std::shared_ptr<const config::Config> config) override {
         events_.push_back("apply " + name_);
         applied.push_back(std::move(config));

@@ -180,6 +180,39 @@ TEST_CASE("a loader failing for another reason is also survived") {
     CHECK(daemon.config() == h.initial);
 }
 
+TEST_CASE("a component refusing to prepare a reload rejects it whole: nothing applied, the reason in STATUS=") {
+    Harness h;
+    FakeComponent lines("lines", h.events);
+    FakeComponent tcp("modbus-tcp", h.events);
+    FakeComponent mqtt("mqtt", h.events);
+    tcp.refuses_prepare = "cannot listen on 127.0.0.1:1502: Address already in use; free the port or change it";
+    h.loader = [&](const std::filesystem::path&) { return config_with(3, 1); };
+    auto& daemon = h.create();
+    daemon.add_component(lines);
+    daemon.add_component(tcp);
+    daemon.add_component(mqtt);
+    int readies = 0;
+    h.manager.on_notify = [&](const std::string& message) {
+        if (starts_with(message, "READY=1")) {
+            ++readies;
+            h.later([&, n = readies] { n == 1 ? daemon.request_reload() : daemon.request_stop("test"); });
+        }
+    };
+    CHECK(h.run() == exit_ok);
+    const auto messages = h.manager.without_pings();
+    REQUIRE(messages.size() >= 4);
+    CHECK(messages[3] == "READY=1\nSTATUS=last reload rejected: cannot listen on 127.0.0.1:1502: "
+                         "Address already in use; free the port or change it, 2 lines, 4 devices");
+    CHECK(daemon.config() == h.initial);
+    CHECK(lines.applied.empty());
+    CHECK(tcp.applied.empty());
+    CHECK(mqtt.applied.empty());
+    // Only the component prepared before the refusal releases what it took.
+    CHECK(h.events == std::vector<std::string>{"start lines", "start modbus-tcp", "start mqtt", "abandon lines",
+                                               "stop mqtt", "stop modbus-tcp", "stop lines"});
+    CHECK(h.logged("<3>configuration reload rejected: modbus-tcp cannot apply it: cannot listen on 127.0.0.1:1502"));
+}
+
 TEST_CASE("a component failing to apply a reload is logged; the others still get it") {
     class Refusing final : public Component {
     public:

@@ -173,6 +173,40 @@ TEST_CASE("a reload keeps an adopted socket, and one that drops its address can 
     CHECK(accepts_connections(io, server, port));
 }
 
+TEST_CASE("reload: prepare() refuses a port in use with nothing changed; a prepared change keeps unchanged listeners") {
+    asio::io_context io;
+    ModbusTcpServer other(io, shared(loopback_config()), {});
+    other.start();
+    ModbusTcpServer server(io, shared(loopback_config()), {});  // 127.0.0.1:0
+    server.start();
+    const auto kept = server.local_endpoints();
+    REQUIRE(kept.size() == 1);
+
+    auto busy = loopback_config();
+    busy.listen.push_back(config::ListenAddress{"127.0.0.1", other.port()});
+    CHECK_THROWS_AS(server.prepare(busy), ModbusTcpError);
+    CHECK(server.local_endpoints() == kept);
+    CHECK(accepts_connections(io, server, kept[0].port()));
+
+    auto more = loopback_config();
+    more.listen.push_back(config::ListenAddress{"127.0.0.1", 0});  // a second one, any port
+    REQUIRE(more.listen.size() == 2);
+    more.listen[1].host = "127.0.0.2";
+    server.prepare(more);
+    CHECK(server.local_endpoints() == kept);  // bound, not serving yet
+    server.apply(shared(more));
+    REQUIRE(server.local_endpoints().size() == 2);
+    CHECK(server.local_endpoints()[0] == kept[0]);  // the same socket
+    CHECK(server.local_endpoints()[1].address().to_string() == "127.0.0.2");
+
+    auto third = loopback_config();
+    third.listen.push_back(config::ListenAddress{"127.0.0.3", 0});
+    server.prepare(third);
+    server.abandon_prepared();  // a rejected reload: nothing changes
+    CHECK(server.local_endpoints().size() == 2);
+    CHECK(server.local_endpoints()[0] == kept[0]);
+}
+
 TEST_CASE("client addresses map to the configuration's form") {
     CHECK(to_ip_address(asio::ip::make_address("127.0.0.1")) == *config::parse_ip_address("127.0.0.1"));
     CHECK(to_ip_address(asio::ip::make_address("::ffff:10.1.2.3")) == *config::parse_ip_address("10.1.2.3"));
