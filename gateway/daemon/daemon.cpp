@@ -220,6 +220,7 @@ void Daemon::reload() {
         }
         logger_->info("configuration reloaded from {} ({})", file.string(), describe_config(*config_));
     }
+    ++(last_reload_rejected_ ? reloads_.rejected : reloads_.ok);
     notify("READY=1\nSTATUS=" + status_.take_if_changed(true).value_or(""));
 }
 

@@ -21,6 +21,7 @@
 // header was read; two choices in one program are an ODR violation (ASan:
 // alloc-dealloc-mismatch).
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -41,6 +42,12 @@
 #include "daemon/status_board.hpp"
 
 namespace fieldbridge::daemon {
+
+/// Configuration reloads since start, by outcome (the Prometheus export reads them).
+struct ReloadCounts {
+    std::uint64_t ok = 0;        ///< the new configuration was applied
+    std::uint64_t rejected = 0;  ///< it could not be loaded: the previous one stays
+};
 
 struct DaemonOptions {
     /// Re-read on SIGHUP.
@@ -78,6 +85,7 @@ public:
     /// The configuration in force (replaced by a successful reload).
     [[nodiscard]] const std::shared_ptr<const config::Config>& config() const noexcept { return config_; }
     [[nodiscard]] Phase phase() const noexcept { return phase_; }
+    [[nodiscard]] const ReloadCounts& reloads() const noexcept { return reloads_; }
 
     /// Registers @p component (not owned). Before run() only.
     void add_component(Component& component);
@@ -134,6 +142,7 @@ private:
     bool ran_ = false;
     bool reload_pending_ = false;
     bool last_reload_rejected_ = false;
+    ReloadCounts reloads_;
     int exit_code_ = 0;
 };
 
