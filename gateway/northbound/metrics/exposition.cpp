@@ -152,6 +152,10 @@ void MetricSet::add_counter(std::string_view name, std::string_view help, Labels
     family(name, help, MetricType::counter, labels).samples.push_back(Sample{std::move(labels), value, {}});
 }
 
+void MetricSet::add_counters(const Labels& labels, std::initializer_list<CounterRow> rows) {
+    for (const CounterRow& row : rows) add_counter(row.name, row.help, labels, static_cast<double>(row.value));
+}
+
 void MetricSet::add_gauge(std::string_view name, std::string_view help, Labels labels, double value) {
     family(name, help, MetricType::gauge, labels).samples.push_back(Sample{std::move(labels), value, {}});
 }

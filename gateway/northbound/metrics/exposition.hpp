@@ -6,6 +6,7 @@
 /// `# TYPE` per metric name, however many label sets), then rendered. Pure: no I/O,
 /// no clock.
 #include <cstdint>
+#include <initializer_list>
 #include <map>
 #include <string>
 #include <string_view>
@@ -34,6 +35,13 @@ struct HistogramValue {
     double sum = 0.0;                   ///< of every sample, base units
 };
 
+/// One counter of a table given to MetricSet::add_counters().
+struct CounterRow {
+    std::string_view name;
+    std::string_view help;
+    std::uint64_t value = 0;
+};
+
 class MetricSet {
 public:
     /// A counter sample; @p name ends in `_total`. Each add_*() throws
@@ -41,6 +49,8 @@ public:
     /// name already used with another type, or a histogram whose counts do not fit
     /// its bounds: a programming error, caught by the unit tests.
     void add_counter(std::string_view name, std::string_view help, Labels labels, double value);
+    /// Counters that share @p labels: one sample of each row.
+    void add_counters(const Labels& labels, std::initializer_list<CounterRow> rows);
     void add_gauge(std::string_view name, std::string_view help, Labels labels, double value);
     /// Writes `<name>_bucket`, `<name>_sum` and `<name>_count`.
     void add_histogram(std::string_view name, std::string_view help, Labels labels, HistogramValue value);

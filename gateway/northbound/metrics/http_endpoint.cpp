@@ -10,13 +10,13 @@
 #include <utility>
 
 #include <asio/ip/tcp.hpp>
-#include <asio/ip/v6_only.hpp>
 #include <asio/posix/stream_descriptor.hpp>
 #include <asio/steady_timer.hpp>
 #include <fmt/format.h>
 #include <microhttpd.h>
 
 #include "northbound/metrics/exposition.hpp"
+#include "northbound/modbus_tcp/listen_socket.hpp"
 
 namespace fieldbridge::northbound::metrics {
 
@@ -49,21 +49,9 @@ constexpr std::string_view metrics_path = "/metrics";
         throw MetricsHttpError(fmt::format("metrics HTTP: cannot listen on {}: {} is not an IP address",
                                            address.to_string(), address.host));
     }
-    const asio::ip::tcp::endpoint endpoint(ip, address.port);
     asio::ip::tcp::acceptor acceptor(io);
     const char* step = "open";
-    acceptor.open(endpoint.protocol(), error);
-    // A restarted gateway rebinds at once despite connections in TIME_WAIT.
-    if (!error) acceptor.set_option(asio::ip::tcp::acceptor::reuse_address(true), error);
-    if (!error && ip.is_v6()) acceptor.set_option(asio::ip::v6_only(true), error);
-    if (!error) {
-        step = "bind";
-        acceptor.bind(endpoint, error);
-    }
-    if (!error) {
-        step = "listen";
-        acceptor.listen(asio::socket_base::max_listen_connections, error);
-    }
+    error = modbus_tcp::bind_and_listen(acceptor, asio::ip::tcp::endpoint(ip, address.port), true, step);
     if (!error) acceptor.non_blocking(true, error);
     if (error) {
         throw MetricsHttpError(fmt::format("metrics HTTP: cannot listen on {} ({} failed: {}): {}",

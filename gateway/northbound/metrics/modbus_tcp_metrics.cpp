@@ -30,22 +30,21 @@ void collect_upstream(MetricSet& out, const upstream::UpstreamTarget& target) {
                       std::move(labels), state == candidate ? 1 : 0);
     }
     const upstream::UpstreamStats s = target.stats();
-    const auto counter = [&out, &name](const char* metric, const char* help, std::uint64_t value) {
-        out.add_counter(metric, help, name, tcp_count(value));
-    };
-    counter("fieldbridge_upstream_requests_total", "Client requests handled for the upstream's units", s.requests);
-    counter("fieldbridge_upstream_forwarded_total", "Frames sent to the upstream (polls included)", s.forwarded);
-    counter("fieldbridge_upstream_replies_total", "Replies matched to a request", s.replies);
-    counter("fieldbridge_upstream_late_replies_total", "Replies that came after their request was answered",
-            s.late_replies);
-    counter("fieldbridge_upstream_malformed_replies_total", "Replies that did not fit their request",
-            s.malformed_replies);
-    counter("fieldbridge_upstream_timeouts_total", "Requests the upstream did not answer in time", s.timeouts);
-    counter("fieldbridge_upstream_expired_total", "Requests whose deadline passed before they were sent", s.expired);
-    counter("fieldbridge_upstream_queue_full_total", "Requests refused because the queue was full", s.queue_full);
-    counter("fieldbridge_upstream_path_down_total", "Requests answered 0x0A because the link was down", s.path_down);
-    counter("fieldbridge_upstream_connects_total", "TCP connections established to the upstream", s.connects);
-    counter("fieldbridge_upstream_poll_cycles_total", "Completed polling cycles", s.poll_cycles);
+    out.add_counters(
+        name,
+        {{"fieldbridge_upstream_requests_total", "Client requests handled for the upstream's units", s.requests},
+         {"fieldbridge_upstream_forwarded_total", "Frames sent to the upstream (polls included)", s.forwarded},
+         {"fieldbridge_upstream_replies_total", "Replies matched to a request", s.replies},
+         {"fieldbridge_upstream_late_replies_total", "Replies that came after their request was answered",
+          s.late_replies},
+         {"fieldbridge_upstream_malformed_replies_total", "Replies that did not fit their request",
+          s.malformed_replies},
+         {"fieldbridge_upstream_timeouts_total", "Requests the upstream did not answer in time", s.timeouts},
+         {"fieldbridge_upstream_expired_total", "Requests whose deadline passed before they were sent", s.expired},
+         {"fieldbridge_upstream_queue_full_total", "Requests refused because the queue was full", s.queue_full},
+         {"fieldbridge_upstream_path_down_total", "Requests answered 0x0A because the link was down", s.path_down},
+         {"fieldbridge_upstream_connects_total", "TCP connections established to the upstream", s.connects},
+         {"fieldbridge_upstream_poll_cycles_total", "Completed polling cycles", s.poll_cycles}});
 }
 
 }  // namespace
@@ -53,8 +52,8 @@ void collect_upstream(MetricSet& out, const upstream::UpstreamTarget& target) {
 void collect_modbus_tcp(MetricSet& out, const modbus_tcp::ServerStats& stats) {
     out.add_gauge("fieldbridge_modbus_tcp_clients", "Modbus TCP client connections open now", {},
                   tcp_count(stats.connections_open));
-    out.add_counter("fieldbridge_modbus_tcp_connections_accepted_total", "Client connections accepted", {},
-                    tcp_count(stats.connections_accepted));
+    out.add_counters({}, {{"fieldbridge_modbus_tcp_connections_accepted_total", "Client connections accepted",
+                           stats.connections_accepted}});
     add_by_reason(out, "fieldbridge_modbus_tcp_connections_refused_total", "Client connections refused, by reason",
                   {{"max_connections", stats.refused_max_connections},
                    {"not_allowed", stats.refused_not_allowed},
@@ -67,19 +66,15 @@ void collect_modbus_tcp(MetricSet& out, const modbus_tcp::ServerStats& stats) {
                    {"output_overflow", stats.closed_output_overflow},
                    {"idle", stats.closed_idle},
                    {"io_error", stats.closed_io_error}});
-    out.add_counter("fieldbridge_modbus_tcp_requests_total", "Complete MBAP requests received", {},
-                    tcp_count(stats.requests));
-    out.add_counter("fieldbridge_modbus_tcp_responses_total", "Responses sent (normal and exception)", {},
-                    tcp_count(stats.responses));
-    out.add_counter("fieldbridge_modbus_tcp_denied_total", "Requests refused by an access rule", {},
-                    tcp_count(stats.denied));
-    out.add_counter("fieldbridge_modbus_tcp_unknown_unit_total", "Requests to a unit ID without a route", {},
-                    tcp_count(stats.unknown_unit));
-    out.add_counter("fieldbridge_modbus_tcp_target_failures_total",
-                    "Requests whose target failed or answered an unusable PDU (answered 0x04)", {},
-                    tcp_count(stats.target_failures));
-    out.add_counter("fieldbridge_modbus_tcp_late_responses_total",
-                    "Answers dropped because their connection had closed", {}, tcp_count(stats.late_responses));
+    out.add_counters(
+        {}, {{"fieldbridge_modbus_tcp_requests_total", "Complete MBAP requests received", stats.requests},
+             {"fieldbridge_modbus_tcp_responses_total", "Responses sent (normal and exception)", stats.responses},
+             {"fieldbridge_modbus_tcp_denied_total", "Requests refused by an access rule", stats.denied},
+             {"fieldbridge_modbus_tcp_unknown_unit_total", "Requests to a unit ID without a route", stats.unknown_unit},
+             {"fieldbridge_modbus_tcp_target_failures_total",
+              "Requests whose target failed or answered an unusable PDU (answered 0x04)", stats.target_failures},
+             {"fieldbridge_modbus_tcp_late_responses_total", "Answers dropped because their connection had closed",
+              stats.late_responses}});
     for (std::size_t code = 0; code < stats.exceptions_by_code.size(); ++code) {
         if (stats.exceptions_by_code[code] == 0) continue;
         out.add_counter("fieldbridge_modbus_tcp_exceptions_total", "Exception responses sent, by exception code",

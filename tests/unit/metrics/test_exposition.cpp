@@ -26,6 +26,18 @@ TEST_CASE("families are written once, in order of their first sample, with HELP 
           "fb_up 1\n");
 }
 
+TEST_CASE("a table of counters shares its labels") {
+    MetricSet set;
+    set.add_counters({{"line", "a"}}, {{"fb_a_total", "A", 1}, {"fb_b_total", "B", 18446744073709551615U}});
+    CHECK(set.render() ==
+          "# HELP fb_a_total A\n"
+          "# TYPE fb_a_total counter\n"
+          "fb_a_total{line=\"a\"} 1\n"
+          "# HELP fb_b_total B\n"
+          "# TYPE fb_b_total counter\n"
+          "fb_b_total{line=\"a\"} 18446744073709551616\n");  // a double: exact up to 2^53
+}
+
 TEST_CASE("label values escape backslash, double quote and newline; HELP escapes backslash and newline") {
     CHECK(escape_label_value(R"(a\b"c)" "\n" "d") == R"(a\\b\"c\nd)");
     CHECK(escape_label_value("plain ü") == "plain ü");

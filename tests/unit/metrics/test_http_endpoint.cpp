@@ -86,13 +86,18 @@ const config::ListenAddress any_loopback_port{"127.0.0.1", 0};
     return set.render();
 }
 
+/// sample_text(), counting the calls in @p renders.
+[[nodiscard]] HttpEndpoint::Render counting(int& renders) {
+    return [&renders] {
+        ++renders;
+        return sample_text();
+    };
+}
+
 TEST_CASE("GET /metrics answers 200 with the text format's content type and the rendered body") {
     asio::io_context io;
     int renders = 0;
-    HttpEndpoint endpoint(io, any_loopback_port, [&renders] {
-        ++renders;
-        return sample_text();
-    });
+    HttpEndpoint endpoint(io, any_loopback_port, counting(renders));
     REQUIRE(endpoint.port() != 0);
     const std::string response = exchange(io, endpoint.port(), request("GET", "/metrics"));
     CHECK(status_line(response) == "HTTP/1.1 200 OK");
@@ -116,10 +121,7 @@ TEST_CASE("HEAD /metrics answers the headers without a body") {
 TEST_CASE("another path is 404, another method 405 with Allow, and neither renders") {
     asio::io_context io;
     int renders = 0;
-    HttpEndpoint endpoint(io, any_loopback_port, [&renders] {
-        ++renders;
-        return sample_text();
-    });
+    HttpEndpoint endpoint(io, any_loopback_port, counting(renders));
     const std::string not_found = exchange(io, endpoint.port(), request("GET", "/"));
     CHECK(status_line(not_found) == "HTTP/1.1 404 Not Found");
     CHECK(status_line(exchange(io, endpoint.port(), request("GET", "/metrics/x"))) == "HTTP/1.1 404 Not Found");
