@@ -11,9 +11,10 @@ packages=(
   # libraries (docs/dependencies.md says why each one is here)
   libmodbus-dev libpaho-mqttpp-dev libpaho-mqtt-dev libssl-dev libyaml-cpp-dev
   libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
-  libcli11-dev
+  libcli11-dev libmicrohttpd-dev
   # test and demo tools
   socat mosquitto mosquitto-clients mbpoll python3 python3-pymodbus
+  prometheus  # promtool check metrics (tests/integration/gateway/test_metrics.py)
   python3-serial-asyncio procps  # pymodbus.client imports serial_asyncio (a Recommends)
   # Debian packages (deploy/build-deb) and their test (tests/package/test-package.sh):
   # systemd for systemd-analyze and systemd-sysusers, man-db for man --warnings
@@ -47,3 +48,5 @@ $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 # The Debian mosquitto package starts a system broker on port 1883; tests and the
 # demo start their own broker on a private loopback port, so the system one is
 # not needed and is left as the package set it up.
+# Likewise the prometheus package (wanted for promtool only) sets up a system
+# Prometheus server on port 9090; the tests do not use it.

@@ -254,6 +254,7 @@ void Daemon::finish_reload(std::shared_ptr<const config::Config> next, std::exce
         }
         logger_->info("configuration reloaded from {} ({})", file.string(), describe_config(*config_));
     }
+    ++(last_reload_rejected_ ? reloads_.rejected : reloads_.ok);
     notify("READY=1\nSTATUS=" + status_.take_if_changed(true).value_or(""));
     if (reload_again_) {
         reload_again_ = false;

@@ -22,6 +22,7 @@
 // alloc-dealloc-mismatch).
 #include <chrono>
 #include <exception>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -43,6 +44,12 @@
 #include "daemon/status_board.hpp"
 
 namespace fieldbridge::daemon {
+
+/// Configuration reloads since start, by outcome (the Prometheus export reads them).
+struct ReloadCounts {
+    std::uint64_t ok = 0;        ///< the new configuration was applied
+    std::uint64_t rejected = 0;  ///< it could not be loaded or applied: the previous one stays
+};
 
 struct DaemonOptions {
     /// Re-read on SIGHUP.
@@ -80,6 +87,7 @@ public:
     /// The configuration in force (replaced by a successful reload).
     [[nodiscard]] const std::shared_ptr<const config::Config>& config() const noexcept { return config_; }
     [[nodiscard]] Phase phase() const noexcept { return phase_; }
+    [[nodiscard]] const ReloadCounts& reloads() const noexcept { return reloads_; }
 
     /// Registers @p component (not owned). Before run() only.
     void add_component(Component& component);
@@ -146,6 +154,7 @@ private:
     bool reload_again_ = false;  ///< SIGHUP while reading: read once more afterwards
     bool last_reload_rejected_ = false;
     std::string rejection_;  ///< why the last reload was rejected, when a component refused it
+    ReloadCounts reloads_;
     int exit_code_ = 0;
 };
 

@@ -19,6 +19,11 @@
 #include "daemon/modbus_tcp_component.hpp"
 #include "northbound/mqtt/mqtt_component.hpp"
 #include "northbound/mqtt/r6_source.hpp"
+#include "northbound/metrics/engine_metrics.hpp"
+#include "northbound/metrics/metrics_component.hpp"
+#include "northbound/metrics/modbus_tcp_metrics.hpp"
+#include "northbound/metrics/mqtt_metrics.hpp"
+#include "northbound/metrics/process_metrics.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_service_manager.hpp"
@@ -115,6 +120,22 @@ using namespace fieldbridge;
     });
     gateway.add_component(mqtt);
     gateway.add_status([&mqtt] { return mqtt.status(); });
+    // Prometheus metrics (off without metrics_http): each collector asks its component
+    // at scrape time, so a rebuilt engine or server is simply what the next scrape sees.
+    namespace metrics = northbound::metrics;
+    metrics::MetricsComponent prometheus(gateway.context(), logger, FIELDBRIDGE_VERSION);
+    prometheus.add_collector([&engine](metrics::MetricSet& out) {
+        if (const auto* lines = engine.engine()) metrics::collect_engine(out, *lines);
+    });
+    prometheus.add_collector([&modbus_tcp](metrics::MetricSet& out) {
+        if (const auto* server = modbus_tcp.server()) metrics::collect_modbus_tcp(out, server->stats());
+        metrics::collect_upstreams(out, modbus_tcp.upstreams());
+    });
+    prometheus.add_collector([&mqtt](metrics::MetricSet& out) { metrics::collect_mqtt(out, mqtt.bridge()); });
+    prometheus.add_collector([&gateway](metrics::MetricSet& out) {
+        metrics::collect_reloads(out, gateway.reloads().ok, gateway.reloads().rejected);
+    });
+    gateway.add_component(prometheus);
     return gateway.run();
 }
 

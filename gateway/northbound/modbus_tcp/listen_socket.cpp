@@ -41,22 +41,16 @@ std::string listen_advice(const asio::error_code& error, const config::ListenAdd
     return "check modbus_tcp.listen";
 }
 
-asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::ListenAddress& address, bool v6_only) {
+asio::error_code bind_and_listen(asio::ip::tcp::acceptor& acceptor, const asio::ip::tcp::endpoint& endpoint,
+                                 bool v6_only, const char*& step) {
     asio::error_code error;
-    const auto ip = asio::ip::make_address(address.host, error);
-    if (error) {
-        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {}: {} is not an IP address",
-                                         address.to_string(), address.host));
-    }
-    const asio::ip::tcp::endpoint endpoint(ip, address.port);
-    asio::ip::tcp::acceptor acceptor(io);
-    const char* step = "open";
+    step = "open";
     acceptor.open(endpoint.protocol(), error);
     if (!error) {
         // A restarted gateway must rebind at once despite connections in TIME_WAIT.
         acceptor.set_option(asio::ip::tcp::acceptor::reuse_address(true), error);
     }
-    if (!error && ip.is_v6()) acceptor.set_option(asio::ip::v6_only(v6_only), error);
+    if (!error && endpoint.address().is_v6()) acceptor.set_option(asio::ip::v6_only(v6_only), error);
     if (!error) {
         step = "bind";
         acceptor.bind(endpoint, error);
@@ -65,6 +59,19 @@ asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::L
         step = "listen";
         acceptor.listen(asio::socket_base::max_listen_connections, error);
     }
+    return error;
+}
+
+asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::ListenAddress& address, bool v6_only) {
+    asio::error_code error;
+    const auto ip = asio::ip::make_address(address.host, error);
+    if (error) {
+        throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {}: {} is not an IP address",
+                                         address.to_string(), address.host));
+    }
+    asio::ip::tcp::acceptor acceptor(io);
+    const char* step = "open";
+    error = bind_and_listen(acceptor, asio::ip::tcp::endpoint(ip, address.port), v6_only, step);
     if (error) {
         throw ModbusTcpError(fmt::format("Modbus TCP: cannot listen on {} ({} failed: {}): {}", address.to_string(),
                                          step, error.message(), listen_advice(error, address)));

@@ -11,6 +11,13 @@
 
 namespace fieldbridge::northbound::modbus_tcp {
 
+/// The steps of opening a listening socket on @p endpoint (open, SO_REUSEADDR,
+/// IPV6_V6ONLY = @p v6_only for IPv6, bind, listen) on @p acceptor. Returns the first
+/// error, with @p step naming the step that failed ("open", "bind", "listen").
+[[nodiscard]] asio::error_code bind_and_listen(asio::ip::tcp::acceptor& acceptor,
+                                               const asio::ip::tcp::endpoint& endpoint, bool v6_only,
+                                               const char*& step);
+
 /// Binds and listens on @p address. @p v6_only applies to IPv6 addresses: set it when
 /// an IPv4 listener shares the port, so that both can bind. Throws ModbusTcpError.
 [[nodiscard]] asio::ip::tcp::acceptor open_listen_socket(asio::io_context& io, const config::ListenAddress& address,

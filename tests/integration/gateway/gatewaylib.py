@@ -273,7 +273,7 @@ modbus_tcp:
     response_timeout: 300ms
     devices:
       - {{name: gripper-3, type: wtec-rtu, address: 1, unit_id: 4, command_ttl: 2s}}
-{extra_devices_b}{extra_lines}{upstreams}{mqtt}"""
+{extra_devices_b}{extra_lines}{upstreams}{mqtt}{metrics}"""
 
 UPSTREAM_CONFIG = """\
 upstreams:
@@ -293,6 +293,12 @@ mqtt:
   min_interval: 100ms
   diag_period: 60s
   reconnect_backoff: {{initial: 200ms, max: 1s}}
+"""
+
+
+METRICS_CONFIG = """\
+metrics_http:
+  listen: 127.0.0.1:{metrics_port}
 """
 
 
@@ -367,13 +373,15 @@ class CellTestCase(unittest.TestCase):
 
     def start_cell(self, r6=False, mqtt=False, extra_devices_a="", extra_devices_b="", extra_lines="",
                    rules="", max_connections=64, sim_line_b="wtec-rtu@1", sim_extra=(), before_gateway=None,
-                   launcher=None, wait_ready=True):
+                   launcher=None, wait_ready=True, metrics=False):
         """Simulator, broker (mqtt=True), before_gateway() if given, gateway; returns
         when the gateway is ready (wait_ready=False: as soon as it was started).
         launcher() returns the command line put before the gateway's own (e.g.
-        systemd-socket-activate), called once the ports are chosen."""
+        systemd-socket-activate), called once the ports are chosen. metrics=True: the
+        Prometheus endpoint on 127.0.0.1:self.metrics_port."""
         self.tcp_port = free_port()
         self.r6_port = free_port() if r6 else None
+        self.metrics_port = free_port() if metrics else None
         args = ["--bus", self.path("line-a") + ":hiwin-xeg@2,excd203mb@3,wtec-ascii@5",
                 "--bus", self.path("line-b") + ":" + sim_line_b,
                 "--control", self.path("sim.sock"), "--wire-time", "--baud", "115200"]
@@ -390,7 +398,8 @@ class CellTestCase(unittest.TestCase):
             extra_devices_a=extra_devices_a, extra_devices_b=extra_devices_b, extra_lines=extra_lines,
             rules=rules,
             upstreams=UPSTREAM_CONFIG.format(r6_port=self.r6_port) if r6 else "",
-            mqtt=self.mqtt_config.format(mqtt_port=self.mqtt_port) if mqtt else "")
+            mqtt=self.mqtt_config.format(mqtt_port=self.mqtt_port) if mqtt else "",
+            metrics=METRICS_CONFIG.format(metrics_port=self.metrics_port) if metrics else "")
         self.config_path = self.path("gateway.yaml")
         with open(self.config_path, "w", encoding="utf-8") as f:
             f.write(config)

@@ -1,0 +1,66 @@
+#pragma once
+/// @file http_endpoint.hpp
+/// `GET /metrics` over HTTP: libmicrohttpd (docs/dependencies.md) driven from the
+/// daemon's asio loop, without a thread of its own. MHD runs in epoll mode; its
+/// epoll descriptor is watched by the loop for readiness, MHD_run() handles what is
+/// ready, and a timer set from MHD_get_timeout() closes idle connections. A scrape
+/// renders on the loop thread (a quick walk over in-memory counters), so it never
+/// races the lines, and the response is copied to MHD at once.
+///
+/// Only GET and HEAD on /metrics: 404 for another path, 405 (with `Allow`) for
+/// another method. Connections are bounded in number and idle time.
+// Standard headers before asio's (see daemon/daemon.hpp).
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <asio/io_context.hpp>
+
+#include "config/config.hpp"
+
+namespace fieldbridge::northbound::metrics {
+
+/// Start-up failures of the endpoint; the message says which address, what failed
+/// and what to do.
+class MetricsHttpError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct HttpEndpointLimits {
+    /// Prometheus scrapes with one connection; a few more for curl and a second server.
+    unsigned max_connections = 8;
+    /// An idle connection is closed after this.
+    std::chrono::seconds connection_timeout{10};
+};
+
+class HttpEndpoint {
+public:
+    /// The body of a 200 answer (Prometheus text). Called on the loop thread; an
+    /// exception becomes a 500 answer whose body is its message.
+    using Render = std::function<std::string()>;
+
+    /// Binds and listens on @p address (port 0: a free port, see port()) and starts
+    /// serving on @p io. Throws MetricsHttpError when the address cannot be used.
+    HttpEndpoint(asio::io_context& io, const config::ListenAddress& address, Render render,
+                 HttpEndpointLimits limits = {});
+    /// Closes the listener and every connection.
+    ~HttpEndpoint();
+    HttpEndpoint(const HttpEndpoint&) = delete;
+    HttpEndpoint& operator=(const HttpEndpoint&) = delete;
+
+    /// The address as configured.
+    [[nodiscard]] const config::ListenAddress& address() const noexcept;
+    /// The port actually bound (differs from address().port when that is 0).
+    [[nodiscard]] std::uint16_t port() const noexcept;
+
+    struct Core;  ///< MHD, the watched descriptor and the timer; shared with pending handlers
+
+private:
+    std::shared_ptr<Core> core_;
+};
+
+}  // namespace fieldbridge::northbound::metrics
