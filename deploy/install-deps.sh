@@ -13,7 +13,7 @@ packages=(
   libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
   libcli11-dev libmicrohttpd-dev
   # test and demo tools
-  socat mosquitto mosquitto-clients mbpoll python3 python3-pymodbus
+  socat mosquitto mosquitto-clients mbpoll curl python3 python3-pymodbus
   prometheus  # promtool check metrics (tests/integration/gateway/test_metrics.py)
   python3-serial-asyncio procps  # pymodbus.client imports serial_asyncio (a Recommends)
   # Debian packages (deploy/build-deb) and their test (tests/package/test-package.sh):
