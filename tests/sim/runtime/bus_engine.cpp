@@ -199,6 +199,7 @@ void BusEngine::collide(std::size_t count, Clock::time_point now) {
 }
 
 void BusEngine::note_silence(Clock::time_point frame_start) {
+    ++window_requests_;
     if (!last_frame_end_) {
         return;
     }
@@ -207,6 +208,7 @@ void BusEngine::note_silence(Clock::time_point frame_start) {
     if (wire_.min_silence.count() < 0 || silence_ns < wire_.min_silence) {
         wire_.min_silence = silence_ns;
     }
+    window_max_silence_ = std::max(window_max_silence_, silence_ns);
     if (silence_ns < settings_.timing.silence()) {
         ++wire_.gap_violations;
         const auto level = wire_.gap_violations <= gap_warnings ? spdlog::level::warn
@@ -217,6 +219,14 @@ void BusEngine::note_silence(Clock::time_point frame_start) {
                   settings_.name, wire_.gap_violations, format_duration(silence),
                   format_duration(settings_.timing.silence()), settings_.timing.baud);
     }
+}
+
+nlohmann::json BusEngine::take_silence_window() {
+    nlohmann::json window{{"requests", window_requests_},
+                          {"max_silence_us", std::chrono::duration<double, std::micro>(window_max_silence_).count()}};
+    window_requests_ = 0;
+    window_max_silence_ = {};
+    return window;
 }
 
 void BusEngine::handle_frame(const Attempt& attempt, Clock::time_point now) {

@@ -86,6 +86,10 @@ public:
                                              Clock::time_point now);
 
     [[nodiscard]] nlohmann::json stats(Clock::time_point now) const;
+    /// The requests seen and the longest silence before one of them (the line's idle
+    /// time between two frames) since the previous call; starts a new window. Lets a
+    /// test measure how long a moment (a reload) left the line idle.
+    [[nodiscard]] nlohmann::json take_silence_window();
     [[nodiscard]] const WireCounters& counters() const noexcept { return wire_; }
     [[nodiscard]] const BusSettings& settings() const noexcept { return settings_; }
 
@@ -132,6 +136,9 @@ private:
     Clock::time_point last_arrival_{};
     Clock::time_point line_free_{};          ///< wire time: when the line is next idle
     std::optional<Clock::time_point> last_frame_end_;
+    /// The silence window (take_silence_window()): since the last call.
+    std::uint64_t window_requests_ = 0;
+    std::chrono::nanoseconds window_max_silence_{};
 
     std::vector<Output> outputs_;            ///< ordered by `at`, stable
     std::size_t queued_replies_ = 0;

@@ -12,7 +12,7 @@ namespace {
 
 constexpr std::string_view help_text =
     "ok commands: stats | device [BUS@]ADDR COMMAND... | fault BUS[@ADDR]:KIND[:MS][:WHEN] | "
-    "fault clear [BUS[@ADDR]] | r6 COMMAND... | help";
+    "fault clear [BUS[@ADDR]] | silence BUS | r6 COMMAND... | help";
 
 std::string_view trim(std::string_view text) {
     while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) {
@@ -63,6 +63,10 @@ std::string Simulator::command(std::string_view line) {
         }
         if (verb == "r6") {
             return command_r6(args);
+        }
+        if (verb == "silence") {
+            if (args.empty()) throw SimError("usage: silence BUS, e.g. silence line-a");
+            return "ok " + bus_named(args).engine().take_silence_window().dump();
         }
         if (verb == "help" || verb.empty()) {
             return std::string(help_text);

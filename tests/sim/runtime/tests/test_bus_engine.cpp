@@ -96,6 +96,26 @@ TEST_CASE("a request sent before 3.5 characters of silence is a gap violation") 
     CHECK(bench.engine->counters().requests == 3);
 }
 
+TEST_CASE("the silence window: requests and the longest idle time before one, since the previous call") {
+    Bench bench(true);
+    const LineTiming timing{115200, 10};
+    bench.engine->on_bytes(read_model, bench.t0);
+    auto reply_at = *bench.engine->next_output();
+    (void)bench.engine->take_due(reply_at);
+    bench.engine->on_bytes(read_status, reply_at + 5ms);  // the line sat idle 5 ms
+    const auto first = bench.engine->take_silence_window();
+    CHECK(first["requests"] == 2);
+    CHECK(first["max_silence_us"].get<double>() == doctest::Approx(5000.0));
+    reply_at = *bench.engine->next_output();
+    (void)bench.engine->take_due(reply_at);
+    bench.engine->on_bytes(read_status, reply_at + timing.silence());
+    const auto second = bench.engine->take_silence_window();  // a new window: the 5 ms is gone
+    CHECK(second["requests"] == 1);
+    CHECK(second["max_silence_us"].get<double>() ==
+          doctest::Approx(std::chrono::duration<double, std::micro>(timing.silence()).count()));
+    CHECK(bench.engine->take_silence_window()["requests"] == 0);
+}
+
 TEST_CASE("two requests back to back: a gap violation after a broadcast, a collision after a reply") {
     Bench bench(true);
     Bytes both = broadcast_move;
