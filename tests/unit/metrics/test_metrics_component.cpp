@@ -8,11 +8,13 @@
 
 #include <asio/io_context.hpp>
 
+#include "app/metrics_component.hpp"
 #include "daemon/completion_barrier.hpp"
-#include "northbound/metrics/metrics_component.hpp"
 
 namespace fieldbridge::northbound::metrics {
 namespace {
+
+using app::MetricsComponent;
 
 [[nodiscard]] std::shared_ptr<const config::Config> with_metrics(std::optional<config::ListenAddress> listen) {
     auto config = std::make_shared<config::Config>();

@@ -24,10 +24,10 @@
 #include "broker_support.hpp"
 #include "loop_support.hpp"
 #include "sim_process.hpp"
+#include "app/mqtt_component.hpp"
 #include "config/config_loader.hpp"
 #include "daemon/completion_barrier.hpp"
 #include "engine/engine.hpp"
-#include "northbound/mqtt/mqtt_component.hpp"
 #include "temp_dir.hpp"
 
 extern char** environ;
@@ -38,7 +38,7 @@ using namespace fbt;
 using namespace std::chrono_literals;
 using nlohmann::json;
 namespace fe = fieldbridge::engine;
-namespace fm = fieldbridge::northbound::mqtt;
+namespace fa = fieldbridge::app;
 namespace fp = fieldbridge::protocol;
 namespace fd = fieldbridge::daemon;
 
@@ -64,7 +64,7 @@ TEST_CASE("MQTT component + engine + simulated XEG + mosquitto") {
         auto logger = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::null_sink_mt>());
         fe::Engine engine(io, *config, fe::LogSink{});
         engine.start();
-        fm::MqttComponent component(io, logger, [&] { return &engine; });
+        fa::MqttComponent component(io, logger, [&] { return &engine; });
         fd::CompletionBarrier ready([] {});
         fd::StartContext start(config, ready);
         component.start(start);

@@ -1,9 +1,9 @@
-#include "northbound/metrics/metrics_component.hpp"
+#include "app/metrics_component.hpp"
 
 #include <exception>
 #include <utility>
 
-namespace fieldbridge::northbound::metrics {
+namespace fieldbridge::app {
 
 MetricsComponent::MetricsComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger, std::string version)
     : io_(io), logger_(std::move(logger)), version_(std::move(version)) {}
@@ -21,7 +21,7 @@ void MetricsComponent::start(daemon::StartContext& context) {
         return;
     }
     auto ready = context.expect_ready("metrics HTTP listener " + config->listen.to_string());
-    open(config->listen);  // throws MetricsHttpError: the daemon exits 1 with its message
+    open(config->listen);  // throws metrics::MetricsHttpError: the daemon exits 1 with its message
     ready.done();
 }
 
@@ -35,8 +35,8 @@ void MetricsComponent::prepare(const config::Config& next) {
     const auto& wanted = next.metrics_http;
     if (!wanted || (endpoint_ && endpoint_->address() == wanted->listen)) return;
     try {
-        prepared_ = std::make_unique<HttpEndpoint>(io_, wanted->listen, [this] { return render(); });
-    } catch (const MetricsHttpError&) {
+        prepared_ = std::make_unique<metrics::HttpEndpoint>(io_, wanted->listen, [this] { return render(); });
+    } catch (const metrics::MetricsHttpError&) {
         // Our own endpoint may hold the port (0.0.0.0 -> 127.0.0.1): apply() binds
         // once it closed. Any other holder rejects the reload.
         if (!endpoint_ || endpoint_->address().port != wanted->listen.port) throw;
@@ -61,7 +61,7 @@ void MetricsComponent::apply(std::shared_ptr<const config::Config> config) {
     }
     try {
         open(wanted->listen);
-    } catch (const MetricsHttpError&) {
+    } catch (const metrics::MetricsHttpError&) {
         if (!endpoint_) throw;
         // The new address may overlap the old one (0.0.0.0 -> 127.0.0.1, same port):
         // free the old listener and try once more.
@@ -70,7 +70,7 @@ void MetricsComponent::apply(std::shared_ptr<const config::Config> config) {
     }
 }
 
-void MetricsComponent::announce(const HttpEndpoint& endpoint) {
+void MetricsComponent::announce(const metrics::HttpEndpoint& endpoint) {
     const auto& address = endpoint.address();
     logger_->info("metrics HTTP endpoint: http://{}:{}/metrics", address.is_ipv6() ? "[" + address.host + "]"
                                                                                     : address.host,
@@ -78,14 +78,14 @@ void MetricsComponent::announce(const HttpEndpoint& endpoint) {
 }
 
 void MetricsComponent::open(const config::ListenAddress& address) {
-    auto endpoint = std::make_unique<HttpEndpoint>(io_, address, [this] { return render(); });
+    auto endpoint = std::make_unique<metrics::HttpEndpoint>(io_, address, [this] { return render(); });
     announce(*endpoint);
     endpoint_ = std::move(endpoint);
 }
 
 std::string MetricsComponent::render() {
     ++scrapes_;
-    MetricSet set;
+    metrics::MetricSet set;
     set.add_gauge("fieldbridge_build_info", "The running fieldbridge's version (always 1)", {{"version", version_}},
                   1);
     set.add_counter("fieldbridge_metrics_scrapes_total", "Scrapes of this endpoint, this one included", {},
@@ -94,4 +94,4 @@ std::string MetricsComponent::render() {
     return set.render();
 }
 
-}  // namespace fieldbridge::northbound::metrics
+}  // namespace fieldbridge::app

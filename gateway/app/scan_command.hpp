@@ -18,7 +18,7 @@
 
 #include "daemon/command_line.hpp"
 
-namespace fieldbridge::scan {
+namespace fieldbridge::app {
 
 /// Exit code when no device answered.
 inline constexpr int exit_nothing_found = 1;
@@ -60,4 +60,4 @@ private:
     std::string parity_text_ = "N";
 };
 
-}  // namespace fieldbridge::scan
+}  // namespace fieldbridge::app

@@ -11,7 +11,7 @@
 
 #include "engine/engine.hpp"
 
-namespace fieldbridge::northbound::mqtt {
+namespace fieldbridge::app {
 
 class EngineDiag {
 public:
@@ -26,4 +26,4 @@ private:
     std::map<std::string, Busy, std::less<>> last_;
 };
 
-}  // namespace fieldbridge::northbound::mqtt
+}  // namespace fieldbridge::app

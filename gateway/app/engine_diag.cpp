@@ -1,8 +1,8 @@
-#include "northbound/mqtt/engine_diag.hpp"
+#include "app/engine_diag.hpp"
 
 #include <array>
 
-namespace fieldbridge::northbound::mqtt {
+namespace fieldbridge::app {
 
 namespace {
 
@@ -103,4 +103,4 @@ json EngineDiag::collect(const engine::Engine& eng, engine::TimePoint now) {
     return json{{"lines", std::move(lines)}};
 }
 
-}  // namespace fieldbridge::northbound::mqtt
+}  // namespace fieldbridge::app

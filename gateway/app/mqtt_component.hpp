@@ -18,17 +18,20 @@
 
 #include <asio/io_context.hpp>
 
+#include "app/engine_diag.hpp"
 #include "daemon/component.hpp"
 #include "engine/engine.hpp"
 #include "northbound/mqtt/agent_source.hpp"
-#include "northbound/mqtt/engine_diag.hpp"
 #include "northbound/mqtt/mqtt_bridge.hpp"
 
-namespace fieldbridge::northbound::mqtt {
+namespace fieldbridge::app {
+
+namespace mqtt = northbound::mqtt;
 
 /// Makes the client of a bridge (tests may inject another).
 using ClientFactory =
-    std::function<std::unique_ptr<Client>(asio::io_context&, const config::MqttConfig&, const std::string& will_topic)>;
+    std::function<std::unique_ptr<mqtt::Client>(asio::io_context&, const config::MqttConfig&,
+                                                 const std::string& will_topic)>;
 [[nodiscard]] ClientFactory paho_client_factory();
 
 class MqttComponent final : public daemon::Component {
@@ -45,14 +48,14 @@ public:
     void apply(std::shared_ptr<const config::Config> config) override;
 
     /// Merged into `<prefix>/diag` (e.g. {"modbus_tcp": {...}}).
-    void add_diag(DiagProvider provider);
+    void add_diag(mqtt::DiagProvider provider);
     /// More devices (the R6 units of the upstream pass-through: make_r6_sources()),
     /// asked at start and whenever the sources are rebuilt. Their owner detaches them
     /// before the objects behind them go.
-    using SourceProvider = std::function<std::vector<std::shared_ptr<DeviceSource>>()>;
+    using SourceProvider = std::function<std::vector<std::shared_ptr<mqtt::DeviceSource>>()>;
     void add_sources(SourceProvider provider);
     /// Nullptr when MQTT is off.
-    [[nodiscard]] const Bridge* bridge() const noexcept { return bridge_.get(); }
+    [[nodiscard]] const mqtt::Bridge* bridge() const noexcept { return bridge_.get(); }
     /// For STATUS=: "MQTT connected" / "MQTT connecting" / "MQTT off".
     [[nodiscard]] std::string status() const;
 
@@ -60,16 +63,16 @@ private:
     void build();
     void refresh_sources();
     void detach_sources();
-    void retire(std::unique_ptr<Bridge> bridge);
+    void retire(std::unique_ptr<mqtt::Bridge> bridge);
 
     asio::io_context& io_;
     std::shared_ptr<spdlog::logger> logger_;
     EngineAccess engine_;
     ClientFactory clients_;
     std::shared_ptr<const config::Config> config_;
-    std::unique_ptr<Bridge> bridge_;
-    std::vector<std::shared_ptr<AgentSource>> sources_;
-    std::vector<DiagProvider> diag_;
+    std::unique_ptr<mqtt::Bridge> bridge_;
+    std::vector<std::shared_ptr<mqtt::AgentSource>> sources_;
+    std::vector<mqtt::DiagProvider> diag_;
     std::vector<SourceProvider> source_providers_;
     EngineDiag engine_diag_;
     bool refresh_pending_ = false;  ///< the engine is being rebuilt: its agents come later
@@ -77,4 +80,4 @@ private:
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
-}  // namespace fieldbridge::northbound::mqtt
+}  // namespace fieldbridge::app

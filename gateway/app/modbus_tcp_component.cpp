@@ -1,10 +1,10 @@
-#include "daemon/modbus_tcp_component.hpp"
+#include "app/modbus_tcp_component.hpp"
 
 #include <unistd.h>
 
 #include <map>
 
-namespace fieldbridge::daemon {
+namespace fieldbridge::app {
 
 namespace {
 
@@ -88,7 +88,7 @@ void ModbusTcpComponent::rebuild_routes(engine::Engine* engine) {
     }
 }
 
-void ModbusTcpComponent::start(StartContext& context) {
+void ModbusTcpComponent::start(daemon::StartContext& context) {
     config_ = context.config();
     server_ = std::make_unique<northbound::modbus_tcp::ModbusTcpServer>(io_, tcp_config(config_),
                                                                          engine_log_sink(logger_));
@@ -101,7 +101,7 @@ void ModbusTcpComponent::start(StartContext& context) {
     server_->start();  // logs each listener
 }
 
-void ModbusTcpComponent::stop(StopContext& /*context*/) {
+void ModbusTcpComponent::stop(daemon::StopContext& /*context*/) {
     if (server_) {
         server_->stop();
         server_->routes().clear();
@@ -134,4 +134,4 @@ void ModbusTcpComponent::apply(std::shared_ptr<const config::Config> config) {
 
 std::string ModbusTcpComponent::status() const { return server_ ? server_->status() : std::string("Modbus TCP off"); }
 
-}  // namespace fieldbridge::daemon
+}  // namespace fieldbridge::app

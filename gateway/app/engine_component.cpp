@@ -1,6 +1,6 @@
-#include "daemon/engine_component.hpp"
+#include "app/engine_component.hpp"
 
-namespace fieldbridge::daemon {
+namespace fieldbridge::app {
 
 engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger) {
     engine::LogSink sink;
@@ -45,14 +45,14 @@ void EngineComponent::tear_down() {
     engine_.reset();
 }
 
-void EngineComponent::start(StartContext& context) {
+void EngineComponent::start(daemon::StartContext& context) {
     config_ = context.config();
     // READY does not wait for the ports: a missing adapter is retried with back-off
     // and reported, and the rest of the gateway (TCP, MQTT) must come up regardless.
     build(*config_);
 }
 
-void EngineComponent::stop(StopContext& /*context*/) { tear_down(); }
+void EngineComponent::stop(daemon::StopContext& /*context*/) { tear_down(); }
 
 void EngineComponent::apply(std::shared_ptr<const config::Config> config) {
     if (!engine_ || (config_ && config_->lines == config->lines)) {
@@ -69,4 +69,4 @@ void EngineComponent::apply(std::shared_ptr<const config::Config> config) {
 
 std::string EngineComponent::status() const { return engine_ ? engine_->status() : std::string("engine stopped"); }
 
-}  // namespace fieldbridge::daemon
+}  // namespace fieldbridge::app

@@ -13,16 +13,16 @@
 #include <string>
 #include <vector>
 
+#include "app/engine_component.hpp"
 #include "daemon/component.hpp"
-#include "daemon/engine_component.hpp"
 #include "northbound/modbus_tcp/server.hpp"
 #include "northbound/targets/line_broadcast_target.hpp"
 #include "northbound/targets/serial_device_target.hpp"
 #include "northbound/upstream/upstream_target.hpp"
 
-namespace fieldbridge::daemon {
+namespace fieldbridge::app {
 
-class ModbusTcpComponent final : public Component {
+class ModbusTcpComponent final : public daemon::Component {
 public:
     /// @p engine must be registered before this component (it starts first).
     /// @p inherited: sockets passed by systemd for modbus_tcp.listen entries
@@ -32,8 +32,8 @@ public:
     ~ModbusTcpComponent() override;
 
     [[nodiscard]] std::string name() const override { return "Modbus TCP server"; }
-    void start(StartContext& context) override;
-    void stop(StopContext& context) override;
+    void start(daemon::StartContext& context) override;
+    void stop(daemon::StopContext& context) override;
     /// Binds new listen addresses (a reload that cannot is rejected as a whole).
     void prepare(const config::Config& next) override;
     void abandon() noexcept override;
@@ -76,4 +76,4 @@ private:
     std::vector<northbound::modbus_tcp::InheritedListener> inherited_;  ///< until start() hands them over
 };
 
-}  // namespace fieldbridge::daemon
+}  // namespace fieldbridge::app

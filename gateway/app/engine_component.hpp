@@ -13,21 +13,21 @@
 #include "daemon/component.hpp"
 #include "engine/engine.hpp"
 
-namespace fieldbridge::daemon {
+namespace fieldbridge::app {
 
 /// The engine's log sink: messages go to @p logger at the matching level, and are
 /// built only when the logger would print them.
 [[nodiscard]] engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger);
 
-class EngineComponent final : public Component {
+class EngineComponent final : public daemon::Component {
 public:
     EngineComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger,
                     engine::PortFactory ports = engine::posix_port_factory());
     ~EngineComponent() override;
 
     [[nodiscard]] std::string name() const override { return "line engine"; }
-    void start(StartContext& context) override;
-    void stop(StopContext& context) override;
+    void start(daemon::StartContext& context) override;
+    void stop(daemon::StopContext& context) override;
     void apply(std::shared_ptr<const config::Config> config) override;
 
     /// Nullptr before start() and after stop().
@@ -55,4 +55,4 @@ private:
     std::vector<ChangeListener> listeners_;
 };
 
-}  // namespace fieldbridge::daemon
+}  // namespace fieldbridge::app

@@ -11,27 +11,27 @@
 #include <type_traits>
 #include <variant>
 
+#include "app/engine_component.hpp"
+#include "app/metrics_component.hpp"
+#include "app/modbus_tcp_component.hpp"
+#include "app/mqtt_component.hpp"
+#include "app/scan_command.hpp"
 #include "config/config_loader.hpp"
 #include "daemon/check_config.hpp"
 #include "daemon/command_line.hpp"
 #include "daemon/daemon.hpp"
-#include "daemon/engine_component.hpp"
-#include "daemon/modbus_tcp_component.hpp"
-#include "northbound/mqtt/mqtt_component.hpp"
-#include "northbound/mqtt/r6_source.hpp"
-#include "northbound/metrics/engine_metrics.hpp"
-#include "northbound/metrics/metrics_component.hpp"
-#include "northbound/metrics/modbus_tcp_metrics.hpp"
-#include "northbound/metrics/mqtt_metrics.hpp"
-#include "northbound/metrics/process_metrics.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_service_manager.hpp"
 #include "daemon/systemd_sockets.hpp"
-#include "scan/scan_command.hpp"
+#include "northbound/metrics/engine_metrics.hpp"
+#include "northbound/metrics/modbus_tcp_metrics.hpp"
+#include "northbound/metrics/mqtt_metrics.hpp"
+#include "northbound/metrics/process_metrics.hpp"
+#include "northbound/mqtt/r6_source.hpp"
 
 #ifndef FIELDBRIDGE_VERSION
-#error "FIELDBRIDGE_VERSION must be defined by the build (gateway/daemon/CMakeLists.txt)"
+#error "FIELDBRIDGE_VERSION must be defined by the build (gateway/app/CMakeLists.txt)"
 #endif
 
 namespace {
@@ -79,15 +79,15 @@ using namespace fieldbridge;
     options.log_level_override = command.log_level;
     daemon::Daemon gateway(std::move(options), std::move(initial), load, manager, logger);
     // Components start in this order and stop in the reverse one.
-    daemon::EngineComponent engine(gateway.context(), logger);
+    app::EngineComponent engine(gateway.context(), logger);
     gateway.add_component(engine);
     gateway.add_status([&engine] { return engine.status(); });
-    daemon::ModbusTcpComponent modbus_tcp(gateway.context(), logger, engine, std::move(inherited));
+    app::ModbusTcpComponent modbus_tcp(gateway.context(), logger, engine, std::move(inherited));
     gateway.add_component(modbus_tcp);
     gateway.add_status([&modbus_tcp] { return modbus_tcp.status(); });
     // MQTT last among the components: stopped first, so `offline` goes out while the
     // lines still run.
-    northbound::mqtt::MqttComponent mqtt(gateway.context(), logger, [&engine] { return engine.engine(); });
+    app::MqttComponent mqtt(gateway.context(), logger, [&engine] { return engine.engine(); });
     std::vector<std::shared_ptr<northbound::mqtt::DeviceSource>> r6_sources;
     mqtt.add_sources([&] {
         northbound::mqtt::detach_r6_sources(r6_sources);
@@ -123,7 +123,7 @@ using namespace fieldbridge;
     // Prometheus metrics (off without metrics_http): each collector asks its component
     // at scrape time, so a rebuilt engine or server is simply what the next scrape sees.
     namespace metrics = northbound::metrics;
-    metrics::MetricsComponent prometheus(gateway.context(), logger, FIELDBRIDGE_VERSION);
+    app::MetricsComponent prometheus(gateway.context(), logger, FIELDBRIDGE_VERSION);
     prometheus.add_collector([&engine](metrics::MetricSet& out) {
         if (const auto* lines = engine.engine()) metrics::collect_engine(out, *lines);
     });
@@ -144,7 +144,7 @@ using namespace fieldbridge;
 int main(int argc, char** argv) {
     try {
         daemon::CommandLine command_line(FIELDBRIDGE_VERSION);
-        scan::ScanCommand scan_command(std::cout, std::cerr);
+        app::ScanCommand scan_command(std::cout, std::cerr);
         command_line.add_subcommand(scan_command);
         const auto command = command_line.parse(argc, argv, std::cout, std::cerr);
         return std::visit(

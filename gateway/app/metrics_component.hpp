@@ -2,7 +2,7 @@
 /// @file metrics_component.hpp
 /// The Prometheus endpoint as a daemon component: off when the configuration has
 /// no `metrics_http` section. What a scrape shows comes from collectors that
-/// gateway/daemon/main.cpp registers (the line engine, Modbus TCP, upstreams, MQTT,
+/// gateway/app/main.cpp registers (the line engine, Modbus TCP, upstreams, MQTT,
 /// reloads), each asked at scrape time on the loop thread: nothing is cached between
 /// scrapes, so a rebuilt engine is simply what the next scrape walks.
 ///
@@ -23,12 +23,14 @@
 #include "northbound/metrics/exposition.hpp"
 #include "northbound/metrics/http_endpoint.hpp"
 
-namespace fieldbridge::northbound::metrics {
+namespace fieldbridge::app {
+
+namespace metrics = northbound::metrics;
 
 class MetricsComponent final : public daemon::Component {
 public:
     /// Adds the samples of one part of the gateway to a scrape.
-    using Collector = std::function<void(MetricSet&)>;
+    using Collector = std::function<void(metrics::MetricSet&)>;
 
     /// @p version is what `fieldbridge_build_info{version=...}` shows.
     MetricsComponent(asio::io_context& io, std::shared_ptr<spdlog::logger> logger, std::string version);
@@ -49,19 +51,19 @@ public:
     /// The text a scrape returns now (also what the endpoint serves).
     [[nodiscard]] std::string render();
     /// Nullptr while the endpoint is off.
-    [[nodiscard]] const HttpEndpoint* endpoint() const noexcept { return endpoint_.get(); }
+    [[nodiscard]] const metrics::HttpEndpoint* endpoint() const noexcept { return endpoint_.get(); }
 
 private:
     void open(const config::ListenAddress& address);
-    void announce(const HttpEndpoint& endpoint);
+    void announce(const metrics::HttpEndpoint& endpoint);
 
     asio::io_context& io_;
     std::shared_ptr<spdlog::logger> logger_;
     std::string version_;
     std::vector<Collector> collectors_;
-    std::unique_ptr<HttpEndpoint> endpoint_;
-    std::unique_ptr<HttpEndpoint> prepared_;  ///< bound by prepare() for the next apply()
+    std::unique_ptr<metrics::HttpEndpoint> endpoint_;
+    std::unique_ptr<metrics::HttpEndpoint> prepared_;  ///< bound by prepare() for the next apply()
     std::uint64_t scrapes_ = 0;
 };
 
-}  // namespace fieldbridge::northbound::metrics
+}  // namespace fieldbridge::app

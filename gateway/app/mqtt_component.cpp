@@ -1,18 +1,19 @@
-#include "northbound/mqtt/mqtt_component.hpp"
+#include "app/mqtt_component.hpp"
 
 #include <utility>
 
 #include <asio/post.hpp>
 
+#include "app/engine_component.hpp"
 #include "config/mqtt_uri.hpp"
-#include "daemon/engine_component.hpp"
 #include "northbound/mqtt/paho_client.hpp"
 
-namespace fieldbridge::northbound::mqtt {
+namespace fieldbridge::app {
 
 ClientFactory paho_client_factory() {
     return [](asio::io_context& io, const config::MqttConfig& config, const std::string& will_topic) {
-        return std::unique_ptr<Client>(std::make_unique<PahoClient>(io, paho_options(config, will_topic)));
+        return std::unique_ptr<mqtt::Client>(
+            std::make_unique<mqtt::PahoClient>(io, mqtt::paho_options(config, will_topic)));
     };
 }
 
@@ -37,17 +38,17 @@ void MqttComponent::build() {
         logger_->info("MQTT: off (no mqtt section, or enabled: false)");
         return;
     }
-    const config::MqttConfig& mqtt = config_->mqtt;
+    const config::MqttConfig& settings = config_->mqtt;
     // Throws (with the URI) when the client library refuses the configuration: the
     // daemon then refuses to start.
-    auto client = clients_(io_, mqtt, mqtt.prefix + "/status");
+    auto client = clients_(io_, settings, settings.prefix + "/status");
     // The URI was validated with the configuration; an unparsable one only loses the probe.
-    std::unique_ptr<BrokerProbe> probe;
-    if (const auto uri = config::parse_mqtt_uri(mqtt.uri)) {
-        probe = std::make_unique<TcpBrokerProbe>(io_, uri.value->host, uri.value->port);
+    std::unique_ptr<mqtt::BrokerProbe> probe;
+    if (const auto uri = config::parse_mqtt_uri(settings.uri)) {
+        probe = std::make_unique<mqtt::TcpBrokerProbe>(io_, uri.value->host, uri.value->port);
     }
-    bridge_ = std::make_unique<Bridge>(io_, bridge_settings(mqtt), std::move(client), daemon::engine_log_sink(logger_),
-                                       std::move(probe));
+    bridge_ = std::make_unique<mqtt::Bridge>(io_, mqtt::bridge_settings(settings), std::move(client),
+                                             engine_log_sink(logger_), std::move(probe));
     bridge_->set_diag_provider([this] {
         nlohmann::json out = nlohmann::json::object();
         if (engine::Engine* e = engine_ ? engine_() : nullptr) out = engine_diag_.collect(*e, engine::Clock::now());
@@ -59,18 +60,18 @@ void MqttComponent::build() {
     });
     if (!refresh_pending_) refresh_sources();
     bridge_->start();
-    logger_->info("MQTT: broker {}, client id {}, prefix {}, MQTT {}", mqtt.uri, mqtt.client_id, mqtt.prefix,
-                  config::to_string(mqtt.version));
+    logger_->info("MQTT: broker {}, client id {}, prefix {}, MQTT {}", settings.uri, settings.client_id, settings.prefix,
+                  config::to_string(settings.version));
 }
 
 void MqttComponent::refresh_sources() {
     detach_sources();
     if (!bridge_) return;
     engine::Engine* e = engine_ ? engine_() : nullptr;
-    std::vector<std::shared_ptr<DeviceSource>> sources;
+    std::vector<std::shared_ptr<mqtt::DeviceSource>> sources;
     if (e != nullptr) {
         for (const engine::DeviceEntry& entry : e->devices()) {
-            auto source = std::make_shared<AgentSource>(io_, *entry.agent, entry.mqtt_commands);
+            auto source = std::make_shared<mqtt::AgentSource>(io_, *entry.agent, entry.mqtt_commands);
             sources_.push_back(source);
             sources.push_back(std::move(source));
         }
@@ -99,11 +100,11 @@ void MqttComponent::stop(daemon::StopContext& context) {
     detach_sources();
 }
 
-void MqttComponent::retire(std::unique_ptr<Bridge> bridge) {
+void MqttComponent::retire(std::unique_ptr<mqtt::Bridge> bridge) {
     if (!bridge) return;
     bridge->set_sources({});
     // Kept alive until its `offline` is out (or the stop timeout passed).
-    auto holder = std::make_shared<std::unique_ptr<Bridge>>(std::move(bridge));
+    auto holder = std::make_shared<std::unique_ptr<mqtt::Bridge>>(std::move(bridge));
     (*holder)->stop([holder]() mutable { holder->reset(); });
 }
 
@@ -134,7 +135,7 @@ void MqttComponent::apply(std::shared_ptr<const config::Config> config) {
     }
 }
 
-void MqttComponent::add_diag(DiagProvider provider) { diag_.push_back(std::move(provider)); }
+void MqttComponent::add_diag(mqtt::DiagProvider provider) { diag_.push_back(std::move(provider)); }
 
 void MqttComponent::add_sources(SourceProvider provider) {
     source_providers_.push_back(std::move(provider));
@@ -146,4 +147,4 @@ std::string MqttComponent::status() const {
     return bridge_->connected() ? "MQTT connected" : "MQTT connecting";
 }
 
-}  // namespace fieldbridge::northbound::mqtt
+}  // namespace fieldbridge::app

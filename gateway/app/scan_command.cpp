@@ -1,4 +1,4 @@
-#include "scan/scan_command.hpp"
+#include "app/scan_command.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -16,7 +16,7 @@
 #include "scan/line_scanner.hpp"
 #include "scan/scan_report.hpp"
 
-namespace fieldbridge::scan {
+namespace fieldbridge::app {
 
 namespace {
 
@@ -124,12 +124,12 @@ int ScanCommand::run(std::optional<config::LogLevel> log_level) {
 
     err_ << "fieldbridge scan: " << options_.port << " at " << format_of(options_) << ", addresses "
          << options_.first << "-" << options_.last << ", timeout " << options_.timeout_ms << " ms\n";
-    ScanResult result;
+    scan::ScanResult result;
     try {
-        LineLink link(port, timing_of(options_), log_to(err_, log_level));
-        LineScanner scanner(link,
-                            ScanRange{static_cast<std::uint8_t>(options_.first), static_cast<std::uint8_t>(options_.last)},
-                            [this](const std::string& text) { err_ << "fieldbridge scan: " << text << '\n'; });
+        scan::LineLink link(port, timing_of(options_), log_to(err_, log_level));
+        scan::LineScanner scanner(
+            link, scan::ScanRange{static_cast<std::uint8_t>(options_.first), static_cast<std::uint8_t>(options_.last)},
+            [this](const std::string& text) { err_ << "fieldbridge scan: " << text << '\n'; });
         result = scanner.run();
     } catch (const engine::SerialPortError& error) {
         err_ << "fieldbridge scan: the scan stopped: " << error.what() << '\n';
@@ -146,10 +146,10 @@ int ScanCommand::run(std::optional<config::LogLevel> log_level) {
              << "), the wiring (A/B swapped?), termination, and the address range\n";
         return exit_nothing_found;
     }
-    out_ << config_snippet(ScannedLine{options_.port, options_.baud, options_.parity, options_.stop_bits},
-                           result.devices);
+    out_ << scan::config_snippet(
+        scan::ScannedLine{options_.port, options_.baud, options_.parity, options_.stop_bits}, result.devices);
     out_.flush();
     return daemon::exit_ok;
 }
 
-}  // namespace fieldbridge::scan
+}  // namespace fieldbridge::app
