@@ -26,6 +26,13 @@ using app::MetricsComponent;
     return std::make_shared<spdlog::logger>("metrics-test");  // no sinks
 }
 
+/// Starts @p component with metrics_http on @p listen (READY is not waited for).
+void start_on(MetricsComponent& component, const config::ListenAddress& listen) {
+    daemon::CompletionBarrier readiness([] {});
+    daemon::StartContext context(with_metrics(listen), readiness);
+    component.start(context);
+}
+
 TEST_CASE("without metrics_http nothing listens and READY does not wait") {
     asio::io_context io;
     MetricsComponent component(io, quiet_logger(), "1.2.3");
@@ -68,9 +75,7 @@ TEST_CASE("with metrics_http the listener is up before READY and a scrape asks e
 TEST_CASE("a reload rebinds only when the address changed, and closes when the section goes") {
     asio::io_context io;
     MetricsComponent component(io, quiet_logger(), "1.2.3");
-    daemon::CompletionBarrier readiness([] {});
-    daemon::StartContext context(with_metrics(config::ListenAddress{"127.0.0.1", 0}), readiness);
-    component.start(context);
+    start_on(component, config::ListenAddress{"127.0.0.1", 0});
     const HttpEndpoint* first = component.endpoint();
     REQUIRE(first != nullptr);
     const std::uint16_t port = first->port();
@@ -92,15 +97,12 @@ TEST_CASE("a reload rebinds only when the address changed, and closes when the s
 TEST_CASE("reload, first phase: a new address in use rejects the reload; prepared, it is taken; abandoned, it goes") {
     asio::io_context io;
     MetricsComponent component(io, quiet_logger(), "1.2.3");
-    daemon::CompletionBarrier readiness([] {});
-    daemon::StartContext context(with_metrics(config::ListenAddress{"127.0.0.1", 0}), readiness);
-    component.start(context);
+    start_on(component, config::ListenAddress{"127.0.0.1", 0});
     const HttpEndpoint* first = component.endpoint();
     REQUIRE(first != nullptr);
 
     MetricsComponent other(io, quiet_logger(), "1.2.3");
-    daemon::StartContext other_context(with_metrics(config::ListenAddress{"127.0.0.2", 0}), readiness);
-    other.start(other_context);
+    start_on(other, config::ListenAddress{"127.0.0.2", 0});
     const config::ListenAddress busy{"127.0.0.2", other.endpoint()->port()};
     CHECK_THROWS_AS(component.prepare(*with_metrics(busy)), MetricsHttpError);
     CHECK(component.endpoint() == first);
