@@ -21,6 +21,7 @@
 #include <variant>
 #include <vector>
 
+#include "engine/profiles/operations.hpp"
 #include "engine/profiles/poll_plan.hpp"
 #include "engine/register_image.hpp"
 #include "engine/transaction.hpp"
@@ -177,6 +178,10 @@ public:
     [[nodiscard]] virtual bool in_motion(const RegisterImage& image) const = 0;
     [[nodiscard]] virtual DecodedState decode_state(const RegisterImage& image) const = 0;
     [[nodiscard]] virtual std::vector<Alarm> alarms(const RegisterImage& image) const = 0;
+
+    /// The device type's MQTT operations (operations.hpp): what each takes and which
+    /// registers it writes. Static storage: valid after this profile is gone.
+    [[nodiscard]] virtual OperationSet operations() const = 0;
 };
 
 }  // namespace fieldbridge::engine
