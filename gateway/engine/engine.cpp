@@ -116,7 +116,7 @@ std::unique_ptr<DeviceAgent> Engine::build_agent(LineEntry& entry, const config:
     const DeviceIndex index = entry.next_index;
     std::unique_ptr<DeviceProfile> profile;
     try {
-        profile = make_profile(to_engine(device.type), profile_options(device));
+        profile = make_profile(device.type, profile_options(device));
     } catch (const ProfileError& error) {
         throw ProfileError(fmt::format("line {}, device {}: {}", line.name, device.name, error.what()));
     }

@@ -57,7 +57,7 @@ void PosixSerialPort::fail(const char* what, int error) {
 void PosixSerialPort::open() {
     if (is_open()) return;
     modbus_t* raw = modbus_new_rtu(settings_.path.c_str(), static_cast<int>(settings_.baud),
-                                   settings_.parity, static_cast<int>(settings_.data_bits),
+                                   core::parity_letter(settings_.parity), static_cast<int>(settings_.data_bits),
                                    static_cast<int>(settings_.stop_bits));
     if (raw == nullptr) fail("cannot create the port context (invalid settings)", errno);
     ctx_.reset(raw);

@@ -13,6 +13,8 @@
 #include "engine/serial_low_latency.hpp"
 #include "protocol/bytes.hpp"
 
+#include "core/parity.hpp"
+
 namespace fieldbridge::engine {
 
 /// The port could not be opened or vanished (USB adapter unplugged, pty closed).
@@ -25,7 +27,7 @@ public:
 struct SerialSettings {
     std::string path;
     unsigned baud = 115200;
-    char parity = 'N';  ///< 'N', 'E' or 'O'
+    core::Parity parity = core::Parity::none;
     unsigned data_bits = 8;
     unsigned stop_bits = 1;
     /// Kernel RS-485 mode (TIOCSRS485): the driver switches the transceiver.
