@@ -94,7 +94,7 @@ void DeviceAgent::Impl::shut_down() {
     const std::vector<OperationPtr> pending = std::move(operations_);
     operations_.clear();
     for (const OperationPtr& op : pending) {
-        answer(op, exception_response(op->request, protocol::ExceptionCode::server_device_failure));
+        answer(op, exception_response(op->request, refusal_for(OutcomeStatus::cancelled)));
     }
 }
 

@@ -4,6 +4,8 @@
 
 #include <asio/post.hpp>
 
+#include "protocol/gateway_exceptions.hpp"
+
 namespace fieldbridge::northbound::mqtt {
 
 std::string_view to_string(CommandSet set) noexcept {
@@ -106,7 +108,7 @@ void AgentSource::set_listener(SourceListener listener) {
 }
 
 std::optional<protocol::ExceptionCode> AgentSource::validate(const protocol::Request& request) const {
-    if (agent_ == nullptr) return protocol::ExceptionCode::gateway_path_unavailable;
+    if (agent_ == nullptr) return protocol::exception_code(protocol::GatewayRefusal::path_down);
     return agent_->profile().validate(request, agent_->image());
 }
 
@@ -114,8 +116,7 @@ void AgentSource::execute(const protocol::Request& request, engine::ResponseHand
     if (agent_ == nullptr) {
         const std::uint8_t function = protocol::function_of(request);
         asio::post(io_, [done = std::move(done), function] {
-            done(protocol::Response{
-                protocol::ExceptionResponse{function, protocol::ExceptionCode::gateway_path_unavailable}});
+            done(protocol::Response{protocol::exception_response(function, protocol::GatewayRefusal::path_down)});
         });
         return;
     }
