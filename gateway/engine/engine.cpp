@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "engine/engine_settings.hpp"
 #include "engine/posix_serial_port.hpp"
 #include "engine/profiles/profile_factory.hpp"
@@ -109,7 +110,7 @@ void Engine::set_broadcast(LineEntry& entry, const config::LineConfig& line) {
 std::unique_ptr<DeviceAgent> Engine::build_agent(LineEntry& entry, const config::LineConfig& line,
                                                  const config::DeviceConfig& device) {
     if (entry.next_index == broadcast_device) {
-        throw std::invalid_argument(fmt::format("line {}: no device index left after {} reloads that swapped "
+        throw core::InvalidArgument(fmt::format("line {}: no device index left after {} reloads that swapped "
                                                 "devices; restart the service",
                                                 line.name, entry.next_index));
     }

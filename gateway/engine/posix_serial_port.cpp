@@ -50,8 +50,8 @@ PosixSerialPort::~PosixSerialPort() { close(); }
 
 void PosixSerialPort::fail(const char* what, int error) {
     close();
-    throw SerialPortError("serial port " + settings_.path + ": " + what + ": " +
-                          std::strerror(error) + " (" + hint_for(error) + ")");
+    throw SerialPortError(std::string(what) + ": " + std::strerror(error), "serial port " + settings_.path,
+                          hint_for(error));
 }
 
 void PosixSerialPort::open() {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
 #include "engine/serial_low_latency.hpp"
 #include "protocol/bytes.hpp"
 
@@ -19,9 +20,9 @@ namespace fieldbridge::engine {
 
 /// The port could not be opened or vanished (USB adapter unplugged, pty closed).
 /// what() says which port, what failed and what to check.
-class SerialPortError : public std::runtime_error {
+class SerialPortError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 struct SerialSettings {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/device_type.hpp"
+#include "core/error.hpp"
 #include "core/word_order.hpp"
 #include "engine/profiles/poll_plan.hpp"
 #include "engine/register_image.hpp"
@@ -62,9 +63,9 @@ struct ProfileOptions {
 };
 
 /// Options a profile cannot work with; what() names the option and the fix.
-class ProfileError : public std::runtime_error {
+class ProfileError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 /// What a northbound request is (spec §3 rules 2, 4, 5, 6; §4 protected registers).

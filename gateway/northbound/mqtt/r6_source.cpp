@@ -5,6 +5,7 @@
 
 #include <asio/post.hpp>
 
+#include "core/error.hpp"
 #include "protocol/gateway_exceptions.hpp"
 
 namespace fieldbridge::northbound::mqtt {
@@ -72,7 +73,7 @@ public:
         if (hub_->target == nullptr) return protocol::exception_code(protocol::GatewayRefusal::path_down);
         try {
             (void)protocol::encode_request(request);
-        } catch (const std::invalid_argument&) {
+        } catch (const core::InvalidArgument&) {
             return protocol::exception_code(protocol::GatewayRefusal::bad_value);
         }
         return std::nullopt;
