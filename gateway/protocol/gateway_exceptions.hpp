@@ -7,6 +7,7 @@
 /// server itself. Pure.
 #include <cstdint>
 
+#include "core/modbus_ids.hpp"
 #include "protocol/bytes.hpp"
 #include "protocol/modbus_pdu.hpp"
 
@@ -34,7 +35,7 @@ enum class GatewayRefusal : std::uint8_t {
 
 /// True for the function codes Modbus defines room for: 1..127.
 [[nodiscard]] constexpr bool is_function_code(std::uint8_t function) noexcept {
-    return function != 0 && function < fc::exception_flag;
+    return core::is_function_code(core::FunctionCode{function});
 }
 
 /// The exception PDU to a request whose first byte is @p function (0 for an empty
