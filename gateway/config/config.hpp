@@ -42,7 +42,6 @@ struct Range {
 // one spelling table each); the configuration uses them under its own namespace.
 using core::DeviceType;
 using core::LogLevel;
-using core::parse_device_type;
 using core::Parity;
 using core::RegisterTable;
 using core::to_string;

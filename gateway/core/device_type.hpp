@@ -21,14 +21,9 @@ inline constexpr NameTable<DeviceType, 5> device_type_names{{
     {"wtec-ascii", DeviceType::wtec_ascii},
     {"modbus", DeviceType::modbus},
 }};
-
-/// "hiwin-xeg", "excd203mb", "wtec-rtu", "wtec-ascii", "modbus".
-[[nodiscard]] constexpr std::string_view to_string(DeviceType type) noexcept {
-    return name_in(device_type_names, type);
-}
-/// The inverse of to_string(DeviceType); nullopt for anything else.
-[[nodiscard]] constexpr std::optional<DeviceType> parse_device_type(std::string_view text) noexcept {
-    return value_in(device_type_names, text);
-}
+template <>
+struct Names<DeviceType> {
+    static constexpr const auto& table = device_type_names;
+};
 
 }  // namespace fieldbridge::core

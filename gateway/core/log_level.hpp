@@ -20,13 +20,9 @@ inline constexpr NameTable<LogLevel, 5> log_level_names{{
     {"warning", LogLevel::warning},
     {"error", LogLevel::error},
 }};
-
-/// "trace", "debug", "info", "warning", "error".
-[[nodiscard]] constexpr std::string_view to_string(LogLevel level) noexcept {
-    return name_in(log_level_names, level);
-}
-[[nodiscard]] constexpr std::optional<LogLevel> parse_log_level(std::string_view text) noexcept {
-    return value_in(log_level_names, text);
-}
+template <>
+struct Names<LogLevel> {
+    static constexpr const auto& table = log_level_names;
+};
 
 }  // namespace fieldbridge::core

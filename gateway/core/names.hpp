@@ -2,7 +2,8 @@
 /// @file names.hpp
 /// The one spelling table of an enumeration: the configuration file, the command
 /// line, logs and MQTT all read and write these names, so each enum has exactly one
-/// table (beside its definition) and to_string / parse are lookups in it.
+/// table (beside its definition, named to it by a specialisation of Names) and the
+/// one to_string / parse<E> below are lookups in it.
 
 #include <array>
 #include <cstddef>
@@ -35,6 +36,25 @@ template <class E, std::size_t N>
         }
     }
     return std::nullopt;
+}
+
+/// Specialised beside each shared enum: `static constexpr const auto& table = ...;`.
+template <class E>
+struct Names;
+
+template <class E>
+concept Named = requires { Names<E>::table; };
+
+/// The spelling of @p value ("unknown" for a value without one).
+template <Named E>
+[[nodiscard]] constexpr std::string_view to_string(E value) noexcept {
+    return name_in(Names<E>::table, value);
+}
+
+/// The value spelled @p text; nullopt for any other text.
+template <Named E>
+[[nodiscard]] constexpr std::optional<E> parse(std::string_view text) noexcept {
+    return value_in(Names<E>::table, text);
 }
 
 }  // namespace fieldbridge::core

@@ -19,14 +19,11 @@ inline constexpr NameTable<Parity, 3> parity_names{{
     {"even", Parity::even},
     {"odd", Parity::odd},
 }};
+template <>
+struct Names<Parity> {
+    static constexpr const auto& table = parity_names;
+};
 
-/// "none", "even" or "odd".
-[[nodiscard]] constexpr std::string_view to_string(Parity parity) noexcept {
-    return name_in(parity_names, parity);
-}
-[[nodiscard]] constexpr std::optional<Parity> parse_parity(std::string_view text) noexcept {
-    return value_in(parity_names, text);
-}
 /// 'N', 'E' or 'O' (libmodbus's `modbus_new_rtu` argument, the "8N1" notation).
 [[nodiscard]] constexpr char parity_letter(Parity parity) noexcept {
     switch (parity) {

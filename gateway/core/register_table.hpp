@@ -22,14 +22,11 @@ inline constexpr NameTable<RegisterTable, table_count> register_table_names{{
     {"holding", RegisterTable::holding},
     {"input", RegisterTable::input},
 }};
+template <>
+struct Names<RegisterTable> {
+    static constexpr const auto& table = register_table_names;
+};
 
-/// "coils", "discrete_inputs", "holding", "input".
-[[nodiscard]] constexpr std::string_view to_string(RegisterTable table) noexcept {
-    return name_in(register_table_names, table);
-}
-[[nodiscard]] constexpr std::optional<RegisterTable> parse_register_table(std::string_view text) noexcept {
-    return value_in(register_table_names, text);
-}
 /// Bit tables hold 0 / 1 values and are read with FC01 / FC02.
 [[nodiscard]] constexpr bool is_bit_table(RegisterTable table) noexcept {
     return table == RegisterTable::coils || table == RegisterTable::discrete_inputs;

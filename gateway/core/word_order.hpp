@@ -17,13 +17,9 @@ inline constexpr NameTable<WordOrder, 2> word_order_names{{
     {"high_first", WordOrder::high_first},
     {"low_first", WordOrder::low_first},
 }};
-
-/// "high_first" or "low_first" (the config spelling).
-[[nodiscard]] constexpr std::string_view to_string(WordOrder order) noexcept {
-    return name_in(word_order_names, order);
-}
-[[nodiscard]] constexpr std::optional<WordOrder> parse_word_order(std::string_view text) noexcept {
-    return value_in(word_order_names, text);
-}
+template <>
+struct Names<WordOrder> {
+    static constexpr const auto& table = word_order_names;
+};
 
 }  // namespace fieldbridge::core

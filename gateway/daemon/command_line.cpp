@@ -70,8 +70,8 @@ Command CommandLine::parse(int argc, const char* const* argv, std::ostream& out,
         return ExitCommand{code == static_cast<int>(CLI::ExitCodes::Success) ? exit_ok : exit_usage};
     }
 
-    // Validated by IsMember above, so parse_log_level cannot fail here.
-    const auto log_level = log_level_text.empty() ? std::nullopt : core::parse_log_level(log_level_text);
+    // Validated by IsMember above, so parse<LogLevel> cannot fail here.
+    const auto log_level = log_level_text.empty() ? std::nullopt : core::parse<core::LogLevel>(log_level_text);
     for (const auto& [command, subcommand] : commands) {
         if (command->parsed()) {
             if (config_option->count() > 0 || check_option->count() > 0) {
