@@ -117,7 +117,7 @@ private:
     /// Starts reading the file on a thread of its own (the loop keeps running).
     void reload();
     /// On the loop once the file is read: rejects it, or prepares and applies it.
-    void finish_reload(std::shared_ptr<const config::Config> next, std::exception_ptr error);
+    void finish_reload(std::shared_ptr<const config::Config> next, std::exception_ptr error, double read_ms);
     /// Reload, first phase: every started component prepares @p next; when one
     /// cannot, the prepared ones abandon, the rejection is logged and kept for
     /// STATUS=, and false is returned.

@@ -3,6 +3,7 @@
 add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/register_image.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/device_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/operations.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/register_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/modbus_profile.cpp

@@ -1,9 +1,9 @@
 // The MQTT command parser (northbound/mqtt/command_parser.hpp, parse_command) as the
-// bridge calls it for a `<prefix>/<device>/cmd` payload: with the device's command
-// set and its register image (WTEC `grip` / `release` read the init direction).
+// bridge calls it for a `<prefix>/<device>/cmd` payload: with the device's operations
+// (its profile's) and its register image (WTEC `grip` / `release` read the init direction).
 // A parsed command's requests go to the device as they are, so each must encode;
 // a refusal must say why.
-// Input: one byte choosing the command set, one byte choosing how many registers
+// Input: one byte choosing the device type's operations, one byte choosing how many registers
 // (0-3) the image holds, 5 bytes per register (table, address, value), then the payload.
 
 #include <cstddef>
@@ -16,15 +16,22 @@
 
 #include "fuzz_input.hpp"
 #include "core/error.hpp"
+#include "engine/profiles/excd_profile.hpp"
+#include "engine/profiles/wtec_common.hpp"
+#include "engine/profiles/xeg_profile.hpp"
 #include "northbound/mqtt/command_parser.hpp"
+#include "northbound/upstream/r6_operations.hpp"
 
 namespace {
 
 namespace mqtt = fieldbridge::northbound::mqtt;
 namespace engine = fieldbridge::engine;
 
-constexpr mqtt::CommandSet command_sets[] = {mqtt::CommandSet::xeg, mqtt::CommandSet::excd, mqtt::CommandSet::wtec,
-                                             mqtt::CommandSet::r6, mqtt::CommandSet::generic};
+/// Every device type's operations (wtec-rtu and wtec-ascii share theirs; a generic
+/// Modbus device has only the raw register ops).
+const engine::OperationSet operation_sets[] = {engine::xeg_operations(), engine::excd_operations(),
+                                               engine::wtec_operations(),
+                                               fieldbridge::northbound::r6::r6_operations(), engine::OperationSet{}};
 constexpr engine::Table tables[] = {engine::Table::coils, engine::Table::discrete_inputs, engine::Table::holding,
                                     engine::Table::input};
 
@@ -32,7 +39,7 @@ constexpr engine::Table tables[] = {engine::Table::coils, engine::Table::discret
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     fieldbridge::fuzz::FuzzInput input(data, size);
-    const auto set = command_sets[input.byte() % std::size(command_sets)];
+    const auto& set = operation_sets[input.byte() % std::size(operation_sets)];
     std::vector<mqtt::RawRegister> registers(input.byte() % 4);
     for (auto& r : registers) {
         r.table = tables[input.byte() % std::size(tables)];

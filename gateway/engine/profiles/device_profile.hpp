@@ -24,6 +24,7 @@
 #include "core/device_type.hpp"
 #include "core/error.hpp"
 #include "core/word_order.hpp"
+#include "engine/profiles/operations.hpp"
 #include "engine/profiles/poll_plan.hpp"
 #include "engine/register_image.hpp"
 #include "engine/transaction.hpp"
@@ -175,6 +176,10 @@ public:
     [[nodiscard]] virtual bool in_motion(const RegisterImage& image) const = 0;
     [[nodiscard]] virtual DecodedState decode_state(const RegisterImage& image) const = 0;
     [[nodiscard]] virtual std::vector<Alarm> alarms(const RegisterImage& image) const = 0;
+
+    /// The device type's MQTT operations (operations.hpp): what each takes and which
+    /// registers it writes. Static storage: valid after this profile is gone.
+    [[nodiscard]] virtual OperationSet operations() const = 0;
 };
 
 }  // namespace fieldbridge::engine

@@ -17,7 +17,14 @@ using protocol::ExceptionCode;
 constexpr std::int64_t position_min = -8'300'000;
 constexpr std::int64_t position_max = 8'300'000;
 
+// Motion commands ("運轉指令").
+constexpr std::uint16_t excd_abs = 0x0100;
+constexpr std::uint16_t excd_rel = 0x0104;
+constexpr std::uint16_t excd_home = 0x0107;
+constexpr std::uint16_t excd_stop = 0x0108;
+constexpr std::uint16_t excd_mstop = 0x0109;
 constexpr std::uint16_t jog = 0x010A;
+constexpr std::uint16_t excd_jog_stop = 0x010C;
 constexpr std::uint16_t rabs = 0x0201;
 constexpr std::uint16_t rin = 0x0203;
 constexpr std::uint16_t rout = 0x0204;
@@ -113,15 +120,15 @@ constexpr std::uint16_t ralarm = 0x02D6;
         system(0x003B, "make", 1, 0x32),
         system(0x003C, "prr", 0, 0xFF),
         // Motion commands 0x0100-0x010C ("運轉指令"): write-only.
-        flagged(reg(0x0100, "abs", 2, w, position_min, position_max), true, false),
+        flagged(reg(excd_abs, "abs", 2, w, position_min, position_max), true, false),
         flagged(reg(0x0102, "sabs", 2, w, position_min, position_max), true, false),
-        flagged(reg(0x0104, "rel", 2, w, position_min, position_max), true, false),
+        flagged(reg(excd_rel, "rel", 2, w, position_min, position_max), true, false),
         flagged(reg(0x0106, "start", 1, w, 0, 0), true, false),
-        flagged(reg(0x0107, "home", 1, w, 0, 0), true, false),
-        flagged(reg(0x0108, "stop", 1, w, 0, 0), true, false, 0),
-        flagged(reg(0x0109, "mstop", 1, w, 0, 0), true, false, 0),
+        flagged(reg(excd_home, "home", 1, w, 0, 0), true, false),
+        flagged(reg(excd_stop, "stop", 1, w, 0, 0), true, false, 0),
+        flagged(reg(excd_mstop, "mstop", 1, w, 0, 0), true, false, 0),
         flagged(reg(jog, "jog", 2, w, position_min, position_max), true, false),
-        flagged(reg(0x010C, "jog stop", 1, w, 0, 0), true, false, 0),
+        flagged(reg(excd_jog_stop, "jog stop", 1, w, 0, 0), true, false, 0),
         // Queries 0x0200-0x020A ("查詢指令"): read-only.
         reg(0x0200, "rms", 1, r, 0, 0xFFFF),
         reg(rabs, "rabs", 2, r, position_min, position_max),
@@ -156,6 +163,39 @@ constexpr std::uint16_t ralarm = 0x02D6;
                          false, false};
 }
 
+// ---- MQTT operations (docs/mqtt.md, "excd203mb") --------------------------------
+
+[[nodiscard]] OperationField excd_pulses(std::string_view name) { return {name, IntegerField{position_min, position_max}}; }
+
+[[nodiscard]] const std::vector<Operation>& excd_operation_table() {
+    static const std::vector<Operation> table{
+        {"abs", {excd_pulses("position")},
+         [](const OperationArgs& a, RegisterValues) {
+             return write_multiple(excd_abs, high_word_first(a.integer("position")));
+         }},
+        {"rel", {excd_pulses("distance")},
+         [](const OperationArgs& a, RegisterValues) {
+             return write_multiple(excd_rel, high_word_first(a.integer("distance")));
+         }},
+        {"home", {}, [](const OperationArgs&, RegisterValues) { return write_single(excd_home, 0); }},
+        // stop decelerates; mstop (immediate) stops at once.
+        {"stop", {{"immediate", BooleanField{}, true}},
+         [](const OperationArgs& a, RegisterValues) {
+             const bool immediate = a.has("immediate") && a.boolean("immediate");
+             return write_single(immediate ? excd_mstop : excd_stop, 0);
+         }},
+        // Seed 002 "Jog": +1 / -1 is one step, +/-8,300,000 runs until jog stop.
+        {"jog",
+         {{"direction", ChoiceField{{"forward", "reverse"}}}, {"mode", ChoiceField{{"inch", "continuous"}}}},
+         [](const OperationArgs& a, RegisterValues) {
+             const std::int64_t magnitude = a.choice("mode") == "continuous" ? position_max : 1;
+             return write_multiple(jog, high_word_first(a.choice("direction") == "forward" ? magnitude : -magnitude));
+         }},
+        {"jog_stop", {}, [](const OperationArgs&, RegisterValues) { return write_single(excd_jog_stop, 0); }},
+    };
+    return table;
+}
+
 [[nodiscard]] std::optional<std::int64_t> pair_in(const RegisterImage& image, std::uint16_t address, bool is_signed) {
     const auto high = image.value(Table::holding, address);
     const auto low = image.value(Table::holding, static_cast<std::uint16_t>(address + 1));
@@ -166,6 +206,8 @@ constexpr std::uint16_t ralarm = 0x02D6;
 }
 
 }  // namespace
+
+OperationSet excd_operations() { return OperationSet{"excd", excd_operation_table()}; }
 
 ExcdProfile::ExcdProfile(const ProfileOptions& options)
     : ModbusProfile(excd_register_map(), excd_wire_functions(), options, options.word_order) {}

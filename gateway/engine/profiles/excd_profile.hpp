@@ -17,6 +17,10 @@
 
 namespace fieldbridge::engine {
 
+/// The MQTT operations (docs/mqtt.md, "excd203mb"): abs, rel, home, stop, jog,
+/// jog_stop (seed 002 "運轉指令"). 32-bit values high word first.
+[[nodiscard]] OperationSet excd_operations();
+
 class ExcdProfile final : public ModbusProfile {
 public:
     explicit ExcdProfile(const ProfileOptions& options);
@@ -26,6 +30,7 @@ public:
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+    [[nodiscard]] OperationSet operations() const override { return excd_operations(); }
 
 private:
     [[nodiscard]] std::optional<protocol::ExceptionCode> check_value(const RegisterDef& def,

@@ -4,7 +4,8 @@
 /// configuration (spec §5). The blocks are the known map: a request outside them
 /// is answered 0x02 locally; writes are allowed only to writable blocks of coils
 /// and holding registers. Adjacent blocks with the same period are read together.
-/// Nothing is decoded (MQTT shows the raw registers); no alarms, never in motion.
+/// Nothing is decoded (MQTT shows the raw registers); no alarms, never in motion, no
+/// MQTT operations beyond the raw register ops.
 
 #include "engine/profiles/modbus_profile.hpp"
 
@@ -20,6 +21,8 @@ public:
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+    /// None of its own: the raw register ops only (docs/mqtt.md, "Every device type").
+    [[nodiscard]] OperationSet operations() const override { return OperationSet{}; }
 
 private:
     [[nodiscard]] std::vector<PollUnit> poll_units() const override;

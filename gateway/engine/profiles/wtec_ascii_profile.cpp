@@ -495,4 +495,6 @@ std::vector<Alarm> WtecAsciiProfile::alarms(const RegisterImage& image) const {
     return wtec_uniform_alarms(image, image.value(Table::input, ext_homing_code));
 }
 
+OperationSet WtecAsciiProfile::operations() const { return wtec_operations(); }
+
 }  // namespace fieldbridge::engine

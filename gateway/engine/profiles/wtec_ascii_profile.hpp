@@ -79,6 +79,7 @@ public:
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+    [[nodiscard]] OperationSet operations() const override;
 
     [[nodiscard]] const RegisterMap& map() const noexcept { return map_; }
     [[nodiscard]] std::uint32_t stroke() const noexcept { return stroke_; }

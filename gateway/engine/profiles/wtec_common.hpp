@@ -82,6 +82,11 @@ inline constexpr std::uint16_t ext_end = 0x1032;           ///< one past the las
 
 namespace fieldbridge::engine {
 
+/// The MQTT operations of both modes (docs/mqtt.md, "wtec-rtu and wtec-ascii"): init,
+/// grip, release, position, force, speed, estop on the uniform map. grip and release
+/// read the init direction (0x0300) from the registers they are given.
+[[nodiscard]] OperationSet wtec_operations();
+
 /// The uniform holding registers. @p ascii_view: 0x0302 is write-only (no ASCII
 /// command reads the "saved" flag) and takes 1 only (0 has no ASCII counterpart).
 [[nodiscard]] std::vector<RegisterDef> wtec_uniform_defs(bool ascii_view);

@@ -57,4 +57,6 @@ std::vector<Alarm> WtecRtuProfile::alarms(const RegisterImage& image) const {
     return wtec_uniform_alarms(image, std::nullopt);
 }
 
+OperationSet WtecRtuProfile::operations() const { return wtec_operations(); }
+
 }  // namespace fieldbridge::engine

@@ -20,6 +20,7 @@ public:
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+    [[nodiscard]] OperationSet operations() const override;
 
 private:
     [[nodiscard]] std::vector<PollUnit> poll_units() const override;

@@ -22,13 +22,19 @@ constexpr std::uint16_t actual_position = 0x0300;   // 0.01 mm
 constexpr std::uint16_t status = 0x0301;     // 0-7, §3.2
 constexpr std::uint16_t firmware = 0x0303;   // 0x0303-0x0306, §3.2
 constexpr std::uint16_t model = 0x0600;
+constexpr std::uint16_t xeg_trigger = 0x0601;
+constexpr std::uint16_t xeg_reset = 0x0610;
+constexpr std::uint16_t xeg_stop = 0x0620;
 constexpr std::uint16_t move_position = 0x0630;
 constexpr std::uint16_t move_speed = 0x0631;
+constexpr std::uint16_t move_flag = 0x0632;
+constexpr std::uint16_t expert_direction = 0x0640;
 constexpr std::uint16_t expert_move = 0x0641;
 constexpr std::uint16_t expert_speed = 0x0642;
 constexpr std::uint16_t hold_stroke = 0x0643;
 constexpr std::uint16_t hold_speed = 0x0644;
 constexpr std::uint16_t hold_force = 0x0645;
+constexpr std::uint16_t expert_flag = 0x0646;
 
 constexpr std::uint16_t status_working = 1;
 
@@ -80,21 +86,21 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
     // registers of spec §4 (device ID, flash save, baud / mode).
     defs.push_back(reg(holding, model, "EG type", Access::read_write, 0, 2660));
     // §3 gives the trigger as 1-63 (§3.4.1 says 0-63: 0 would trigger nothing).
-    defs.push_back(motion(reg(holding, 0x0601, "trigger", Access::read_write, 1, 63), true));
-    defs.push_back(motion(reg(holding, 0x0610, "reset", Access::read_write, 0, 1), true));
-    RegisterDef stop = motion(reg(holding, 0x0620, "stop", Access::read_write, 0, 1), true);
+    defs.push_back(motion(reg(holding, xeg_trigger, "trigger", Access::read_write, 1, 63), true));
+    defs.push_back(motion(reg(holding, xeg_reset, "reset", Access::read_write, 0, 1), true));
+    RegisterDef stop = motion(reg(holding, xeg_stop, "stop", Access::read_write, 0, 1), true);
     stop.stop_value = 1;
     defs.push_back(std::move(stop));
     defs.push_back(motion(reg(holding, move_position, "move", Access::read_write, 0, 6400)));
     defs.push_back(motion(reg(holding, move_speed, "move speed", Access::read_write, 0, 10000)));
-    defs.push_back(motion(reg(holding, 0x0632, "move flag", Access::read_write, 0, 1), true));
-    defs.push_back(motion(reg(holding, 0x0640, "expert direction", Access::read_write, 0, 1)));
+    defs.push_back(motion(reg(holding, move_flag, "move flag", Access::read_write, 0, 1), true));
+    defs.push_back(motion(reg(holding, expert_direction, "expert direction", Access::read_write, 0, 1)));
     defs.push_back(motion(reg(holding, expert_move, "expert move", Access::read_write, 0, 6400)));
     defs.push_back(motion(reg(holding, expert_speed, "expert speed", Access::read_write, 0, 10000)));
     defs.push_back(motion(reg(holding, hold_stroke, "holding stroke", Access::read_write, 0, 6400)));
     defs.push_back(motion(reg(holding, hold_speed, "holding speed", Access::read_write, 0, 2000)));
     defs.push_back(motion(reg(holding, hold_force, "holding force", Access::read_write, 40, 100)));
-    defs.push_back(motion(reg(holding, 0x0646, "expert flag", Access::read_write, 0, 1), true));
+    defs.push_back(motion(reg(holding, expert_flag, "expert flag", Access::read_write, 0, 1), true));
     return std::make_shared<const RegisterMap>(std::move(defs));
 }
 
@@ -104,6 +110,42 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
                           protocol::fc::read_input_registers, protocol::fc::write_single_register,
                           protocol::fc::read_exception_status, protocol::fc::write_multiple_registers},
                          true, false};
+}
+
+// ---- MQTT operations (docs/mqtt.md, "hiwin-xeg"; seed 001 §3.4) -----------------
+
+/// Any 16-bit register of 0.01 mm (or mm/s); check_value() applies the model's limits.
+constexpr double xeg_max_mm = 655.35;
+
+[[nodiscard]] OperationField xeg_mm(std::string_view name) { return {name, NumberField{0.0, xeg_max_mm}}; }
+
+[[nodiscard]] const std::vector<Operation>& xeg_operation_table() {
+    static const std::vector<Operation> table{
+        {"reset", {}, [](const OperationArgs&, RegisterValues) { return write_single(xeg_reset, 1); }},
+        {"stop", {}, [](const OperationArgs&, RegisterValues) { return write_single(xeg_stop, 1); }},
+        // Position, speed and the move flag: one FC16 (§3.4.2).
+        {"move", {xeg_mm("position_mm"), xeg_mm("speed_mm_s")},
+         [](const OperationArgs& a, RegisterValues) {
+             return write_multiple(move_position,
+                                   {hundredths(a.number("position_mm")), hundredths(a.number("speed_mm_s")), 1});
+         }},
+        // Expert: direction, stroke, speed, holding stroke and speed, force, flag (§3.4.2).
+        {"expert",
+         {{"direction", IntegerField{0, 1}}, xeg_mm("stroke_mm"), xeg_mm("speed_mm_s"), xeg_mm("holding_stroke_mm"),
+          xeg_mm("holding_speed_mm_s"), {"force_pct", IntegerField{0, 100}}},
+         [](const OperationArgs& a, RegisterValues) {
+             return write_multiple(expert_direction,
+                                   {static_cast<std::uint16_t>(a.integer("direction")), hundredths(a.number("stroke_mm")),
+                                    hundredths(a.number("speed_mm_s")), hundredths(a.number("holding_stroke_mm")),
+                                    hundredths(a.number("holding_speed_mm_s")),
+                                    static_cast<std::uint16_t>(a.integer("force_pct")), 1});
+         }},
+        {"trigger", {{"index", IntegerField{1, 63}}},
+         [](const OperationArgs& a, RegisterValues) {
+             return write_single(xeg_trigger, static_cast<std::uint16_t>(a.integer("index")));
+         }},
+    };
+    return table;
 }
 
 [[nodiscard]] XegModelLimits limits_in(const RegisterImage& image) {
@@ -153,6 +195,8 @@ std::string_view xeg_status_name(std::uint16_t value) noexcept {
                                                     "position_alarm", "move_alarm", "home_alarm", "emergency_stop"};
     return value < names.size() ? names[value] : "unknown";
 }
+
+OperationSet xeg_operations() { return OperationSet{"xeg", xeg_operation_table()}; }
 
 XegProfile::XegProfile(const ProfileOptions& options)
     : ModbusProfile(xeg_register_map(), xeg_wire_functions(), options, WordOrder::high_first) {}

@@ -44,6 +44,10 @@ struct XegModelLimits {
 /// "home_alarm", "emergency_stop" for status 0-7 (seed 001 §3.2); "unknown" else.
 [[nodiscard]] std::string_view xeg_status_name(std::uint16_t status) noexcept;
 
+/// The MQTT operations (docs/mqtt.md, "hiwin-xeg"): reset, stop, move, expert,
+/// trigger (seed 001 §3.4).
+[[nodiscard]] OperationSet xeg_operations();
+
 class XegProfile final : public ModbusProfile {
 public:
     explicit XegProfile(const ProfileOptions& options);
@@ -52,6 +56,7 @@ public:
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;
+    [[nodiscard]] OperationSet operations() const override { return xeg_operations(); }
     /// As ModbusProfile::apply(); an acknowledged write of the model (0x0600) asks
     /// for a read of it back (follow_up), as Appendix 1 does after writing it.
     [[nodiscard]] ApplyResult apply(const Payload& sent, const Reply& reply, RegisterImage& image,

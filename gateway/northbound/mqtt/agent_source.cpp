@@ -8,28 +8,6 @@
 
 namespace fieldbridge::northbound::mqtt {
 
-std::string_view to_string(CommandSet set) noexcept {
-    switch (set) {
-        case CommandSet::xeg: return "xeg";
-        case CommandSet::excd: return "excd";
-        case CommandSet::wtec: return "wtec";
-        case CommandSet::r6: return "r6";
-        case CommandSet::generic: return "generic";
-    }
-    return "generic";
-}
-
-CommandSet command_set_of(engine::DeviceType type) noexcept {
-    switch (type) {
-        case engine::DeviceType::hiwin_xeg: return CommandSet::xeg;
-        case engine::DeviceType::excd203mb: return CommandSet::excd;
-        case engine::DeviceType::wtec_rtu:
-        case engine::DeviceType::wtec_ascii: return CommandSet::wtec;
-        case engine::DeviceType::modbus: return CommandSet::generic;
-    }
-    return CommandSet::generic;
-}
-
 SourceState image_state(const engine::DeviceProfile& profile, const engine::RegisterImage& image, bool online) {
     SourceState s;
     s.online = online && !image.offline();
@@ -61,6 +39,7 @@ AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool 
       agent_(&agent),
       name_(agent.config().name),
       type_(agent.profile().type()),
+      operations_(agent.profile().operations()),
       commands_enabled_(commands_enabled),
       listener_(std::make_shared<SourceListener>()) {
     const std::weak_ptr<SourceListener> weak = listener_;
@@ -85,8 +64,6 @@ void AgentSource::detach() noexcept {
 }
 
 std::string_view AgentSource::type() const { return engine::to_string(type_); }
-
-CommandSet AgentSource::command_set() const { return command_set_of(type_); }
 
 SourceState AgentSource::state() const {
     if (agent_ == nullptr) {

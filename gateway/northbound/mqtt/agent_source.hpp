@@ -24,7 +24,8 @@ public:
 
     [[nodiscard]] const std::string& name() const override { return name_; }
     [[nodiscard]] std::string_view type() const override;
-    [[nodiscard]] CommandSet command_set() const override;
+    /// The profile's, kept: valid after detach() (operations.hpp: static storage).
+    [[nodiscard]] engine::OperationSet operations() const override { return operations_; }
     [[nodiscard]] bool commands_enabled() const override { return commands_enabled_; }
     [[nodiscard]] SourceState state() const override;
     [[nodiscard]] std::vector<engine::Alarm> alarms() const override;
@@ -40,6 +41,7 @@ private:
     engine::DeviceAgent* agent_;
     std::string name_;
     engine::DeviceType type_;
+    engine::OperationSet operations_;
     bool commands_enabled_;
     engine::RegisterImage::SubscriptionId subscription_ = 0;
     // Shared with the image's listener and the notice callback, which the engine

@@ -2,13 +2,14 @@
 /// @file command_parser.hpp
 /// `<prefix>/<device>/cmd` payloads -> Modbus requests (docs/mqtt.md, "Commands").
 /// A command is a JSON object with an `id` (string or number, echoed in the result),
-/// an `op` of the device's command set, and the op's fields; nothing else. The
-/// parser checks JSON types and the ranges it can know without the device (16-bit
-/// registers, signed 32-bit positions, enumerations); the device's profile checks the
-/// rest (model-dependent strokes, protected registers) before anything is sent.
-/// Some ops depend on the device's registers: WTEC `grip` / `release` move to 100 %
-/// or 0 % depending on the init direction (holding 0x0300), since 0 % is the end the
-/// gripper homes to (docs/registers.md). Pure.
+/// an `op` of the device's operations, and the op's fields; nothing else. The parser
+/// knows no device: it checks the fields against the operation's specs (JSON types,
+/// the ranges the profile can state without the device, engine/profiles/operations.hpp)
+/// and asks the operation for its requests, which may depend on the device's register
+/// values (an op that needs one the gateway does not hold is refused, state_unknown).
+/// The device's profile checks the rest (model-dependent strokes, protected
+/// registers) before anything is sent. The raw register ops `set_register` and
+/// `write_registers` are the parser's own: every device takes them. Pure.
 #include <span>
 #include <string>
 #include <string_view>
@@ -34,7 +35,7 @@ struct ParsedCommand {
 enum class CommandErrorKind : std::uint8_t {
     bad_json,       ///< not JSON, or not an object
     missing_id,     ///< no `id`, or not a string / number
-    unknown_op,     ///< no `op`, or not one of the device's command set
+    unknown_op,     ///< no `op`, or not one of the device's operations
     missing_field,
     invalid_field,  ///< wrong JSON type, or a field the op does not take
     out_of_range,
@@ -53,12 +54,14 @@ struct CommandError {
 
 using ParseResult = std::variant<ParsedCommand, CommandError>;
 
-/// @p registers: the device's register image as the source shows it
-/// (SourceState::raw: every register that has a value); ops that need none ignore it.
-[[nodiscard]] ParseResult parse_command(std::string_view payload, CommandSet set,
+/// @p operations: the device's (DeviceSource::operations()); @p registers: its
+/// register image as the source shows it (SourceState::raw: every register that has
+/// a value); ops that need none ignore it.
+[[nodiscard]] ParseResult parse_command(std::string_view payload, const engine::OperationSet& operations,
                                         std::span<const RawRegister> registers);
 
-/// The ops of @p set, for error messages and docs.
-[[nodiscard]] std::vector<std::string_view> command_ops(CommandSet set);
+/// The ops a device of @p operations takes: its own, then the raw register ops (for
+/// error messages and docs).
+[[nodiscard]] std::vector<std::string_view> command_ops(const engine::OperationSet& operations);
 
 }  // namespace fieldbridge::northbound::mqtt

@@ -19,7 +19,7 @@
 
 namespace fieldbridge::northbound::mqtt {
 
-/// "FC16 0x0630 x3" (for messages).
+/// "FC16 <address, 4 hex digits> x<count>" (for messages).
 [[nodiscard]] std::string describe(const protocol::Request& request);
 
 /// The outcome of a response that ends with a Modbus exception (the error kinds of

@@ -18,20 +18,8 @@
 
 namespace fieldbridge::northbound::mqtt {
 
-/// Which command vocabulary a device understands (docs/mqtt.md, "Commands").
-enum class CommandSet : std::uint8_t { xeg, excd, wtec, r6, generic };
-
-/// "xeg", "excd", "wtec", "r6", "generic".
-[[nodiscard]] std::string_view to_string(CommandSet set) noexcept;
-/// The command set of a serial device type.
-[[nodiscard]] CommandSet command_set_of(engine::DeviceType type) noexcept;
-
-struct RawRegister {
-    engine::Table table = engine::Table::holding;
-    std::uint16_t address = 0;
-    std::uint16_t value = 0;
-    bool operator==(const RawRegister&) const = default;
-};
+/// One register value the source holds (SourceState::raw).
+using RawRegister = engine::RegisterValue;
 
 /// One look at a device.
 struct SourceState {
@@ -62,7 +50,9 @@ public:
     [[nodiscard]] virtual const std::string& name() const = 0;
     /// The configured type ("hiwin-xeg", ..., "r6").
     [[nodiscard]] virtual std::string_view type() const = 0;
-    [[nodiscard]] virtual CommandSet command_set() const = 0;
+    /// The MQTT operations of its type (its profile's; none but the raw register ops
+    /// for a generic Modbus device): docs/mqtt.md, "Commands".
+    [[nodiscard]] virtual engine::OperationSet operations() const = 0;
     /// False: `mqtt_commands: false` in the device's config; every command is refused.
     [[nodiscard]] virtual bool commands_enabled() const = 0;
 

@@ -477,10 +477,11 @@ private:
         }
         const ParseResult parsed = [&]() -> ParseResult {
             const auto it = devices_.find(name);
-            if (it == devices_.end()) return parse_command(message.payload, CommandSet::generic, {});
+            // No device: parsed only for the id and op the refusal echoes.
+            if (it == devices_.end()) return parse_command(message.payload, engine::OperationSet{}, {});
             // Some ops depend on the device's registers (WTEC grip / release: the init direction).
             const DeviceSource& source = *it->second->source;
-            return parse_command(message.payload, source.command_set(), source.state().raw);
+            return parse_command(message.payload, source.operations(), source.state().raw);
         }();
         json id;
         std::string op;

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "protocol/gateway_exceptions.hpp"
+#include "northbound/upstream/r6_operations.hpp"
 
 namespace fieldbridge::northbound::mqtt {
 
@@ -33,7 +34,7 @@ public:
 
     const std::string& name() const override { return name_; }
     std::string_view type() const override { return "r6"; }
-    CommandSet command_set() const override { return CommandSet::r6; }
+    engine::OperationSet operations() const override { return r6::r6_operations(); }
     bool commands_enabled() const override { return true; }
 
     SourceState state() const override {

@@ -4,8 +4,8 @@
 /// the MQTT bridge: state and alarms from the target's R6 state poller, change
 /// notifications from its state callback, commands sent through the target like a
 /// Modbus TCP client's (same queue discipline: writes to the command block are
-/// commands). The R6 has no profile: the command parser's ranges are the only local
-/// checks, and the controller answers the rest.
+/// commands). The R6 has no device profile: its operations (r6_operations.hpp) hold
+/// the only local checks, and the controller answers the rest.
 ///
 /// The target's state callback is taken over (one per target). The target must
 /// outlive the sources or be detached from them first (detach_r6_sources()). Loop

@@ -38,7 +38,16 @@ inline constexpr std::uint16_t command_stop = 0x4E20;
 inline constexpr std::uint16_t command_pause = 0x4E21;
 inline constexpr std::uint16_t command_start_button = 0x4E23;
 inline constexpr std::uint16_t command_stop_button = 0x4E24;
+/// Clear the alarm and run the next instruction / continue the automatic run.
+inline constexpr std::uint16_t command_clear_alarm_next = 0x4E25;
+inline constexpr std::uint16_t command_clear_alarm_continue = 0x4E26;
 inline constexpr Span command_block{0x4E20, 0x4E26};
+
+// seed 004 3.3.3: output point control, FC16 only: board ID (0-3 IO, 4-6 M, 7 EUIO),
+// point 0-31, state 0 / 1 at 0x4E58-0x4E5A.
+inline constexpr std::uint16_t output_control = 0x4E58;
+// seed 004 3.2.2: global speed, 0-1000 for 0.0-100.0 %.
+inline constexpr std::uint16_t global_speed = 0x4EE8;
 
 // State polled for MQTT (seed 004 3.1.5-3.1.15, section 4).
 inline constexpr std::uint16_t mode = 0x0889;           ///< 1 manual, 2 auto (3.1.5 example: 3, configuration)

@@ -114,7 +114,12 @@ TEST_CASE("a valid reload: RELOADING=1, components get the new configuration, RE
     REQUIRE(tcp.applied.size() == 1);
     CHECK(h.events == std::vector<std::string>{"start lines", "start modbus-tcp", "apply lines", "apply modbus-tcp",
                                                "stop modbus-tcp", "stop lines"});
-    CHECK(h.logged("<6>configuration reloaded from gw.yaml (3 lines, 3 devices, MQTT disabled)\n"));
+    CHECK(h.logged("<6>configuration reloaded from gw.yaml (3 lines, 3 devices, MQTT disabled); read and checked in "));
+    // What each component held the loop for, in the order they applied.
+    const auto text = h.log_text.str();
+    const auto lines_at = text.find("on the loop (lines ");
+    REQUIRE(lines_at != std::string::npos);
+    CHECK(text.find(" ms, modbus-tcp ", lines_at) != std::string::npos);
 }
 
 TEST_CASE("an invalid reload is rejected: every diagnostic logged, the old configuration stays") {

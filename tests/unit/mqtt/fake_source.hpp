@@ -7,6 +7,8 @@
 #include <asio/io_context.hpp>
 #include <asio/post.hpp>
 
+#include "engine/profiles/wtec_common.hpp"
+#include "engine/profiles/xeg_profile.hpp"
 #include "northbound/mqtt/device_source.hpp"
 
 namespace fbt {
@@ -17,8 +19,8 @@ namespace fp = fieldbridge::protocol;
 
 class FakeSource final : public fm::DeviceSource {
 public:
-    FakeSource(asio::io_context& io, std::string name, fm::CommandSet set = fm::CommandSet::xeg)
-        : io_(io), name_(std::move(name)), set_(set) {
+    FakeSource(asio::io_context& io, std::string name, fe::OperationSet operations = fe::xeg_operations())
+        : io_(io), name_(std::move(name)), operations_(operations) {
         state_.online = true;
         state_.quality = fe::Quality::good;
         state_.updated = fe::Clock::now();
@@ -27,7 +29,7 @@ public:
 
     const std::string& name() const override { return name_; }
     std::string_view type() const override { return "hiwin-xeg"; }
-    fm::CommandSet command_set() const override { return set_; }
+    fe::OperationSet operations() const override { return operations_; }
     bool commands_enabled() const override { return commands_enabled_; }
     fm::SourceState state() const override { return state_; }
     std::vector<fe::Alarm> alarms() const override { return alarms_; }
@@ -83,7 +85,7 @@ public:
 private:
     asio::io_context& io_;
     std::string name_;
-    fm::CommandSet set_;
+    fe::OperationSet operations_;
     fm::SourceState state_;
     std::vector<fe::Alarm> alarms_;
     fm::SourceListener listener_;

@@ -190,7 +190,7 @@ TEST_CASE("bridge: WTEC grip uses the device's init direction; unknown, nothing 
     asio::io_context io;
     auto log = std::make_shared<ScriptedClient::Log>();
     fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
-    auto source = std::make_shared<FakeSource>(io, "w1", fm::CommandSet::wtec);
+    auto source = std::make_shared<FakeSource>(io, "w1", fe::wtec_operations());
     bridge.set_sources({source});
     bridge.start();
     run(io, 20ms);
