@@ -1,5 +1,7 @@
 #include "app/engine_component.hpp"
 
+#include "daemon/logging.hpp"
+
 namespace fieldbridge::app {
 
 engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger) {
@@ -8,12 +10,7 @@ engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger) {
     // change it), so it lets everything through and the logger decides.
     sink.min_level = engine::LogLevel::debug;
     sink.write = [logger = std::move(logger)](engine::LogLevel level, std::string_view message) {
-        switch (level) {
-            case engine::LogLevel::debug: logger->debug("{}", message); break;
-            case engine::LogLevel::info: logger->info("{}", message); break;
-            case engine::LogLevel::warning: logger->warn("{}", message); break;
-            case engine::LogLevel::error: logger->error("{}", message); break;
-        }
+        logger->log(daemon::to_spdlog_level(level), "{}", message);
     };
     return sink;
 }

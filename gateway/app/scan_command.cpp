@@ -26,9 +26,7 @@ constexpr unsigned max_timeout_ms = 10000;
 
 [[nodiscard]] engine::LogSink log_to(std::ostream& err, std::optional<config::LogLevel> level) {
     engine::LogSink sink;
-    sink.min_level = level && (*level == config::LogLevel::debug || *level == config::LogLevel::trace)
-                         ? engine::LogLevel::debug
-                         : engine::LogLevel::warning;
+    sink.min_level = level && *level <= core::LogLevel::debug ? core::LogLevel::debug : core::LogLevel::warning;
     sink.write = [&err](engine::LogLevel l, std::string_view message) {
         err << "fieldbridge scan: " << engine::to_string(l) << ": " << message << '\n';
     };
@@ -39,7 +37,7 @@ constexpr unsigned max_timeout_ms = 10000;
     engine::LineTimingConfig t;
     t.baud = o.baud;
     t.data_bits = 8;
-    t.parity = o.parity != 'N';
+    t.parity = o.parity != core::Parity::none;
     t.stop_bits = o.stop_bits;
     t.response_timeout = std::chrono::milliseconds{o.timeout_ms};
     t.ascii_frame_timeout = std::chrono::milliseconds{o.timeout_ms};
@@ -52,7 +50,7 @@ constexpr unsigned max_timeout_ms = 10000;
 }
 
 [[nodiscard]] std::string format_of(const ScanOptions& o) {
-    return std::to_string(o.baud) + " bit/s, 8" + std::string(1, o.parity) + std::to_string(o.stop_bits);
+    return std::to_string(o.baud) + " bit/s, 8" + std::string(1, core::parity_letter(o.parity)) + std::to_string(o.stop_bits);
 }
 
 }  // namespace
@@ -100,7 +98,8 @@ void ScanCommand::define(CLI::App& command) {
 }
 
 int ScanCommand::run(std::optional<config::LogLevel> log_level) {
-    options_.parity = static_cast<char>(std::toupper(static_cast<unsigned char>(parity_text_.front())));
+    // Validated by the option's check, so the letter is N, E or O in either case.
+    options_.parity = core::parse_parity_letter(parity_text_.front()).value_or(core::Parity::none);
     if (options_.first > options_.last) {
         err_ << "fieldbridge scan: --from " << options_.first << " is above --to " << options_.last
              << "; give the first address, then the last\n";

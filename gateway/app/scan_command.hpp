@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "core/parity.hpp"
 #include "daemon/command_line.hpp"
 
 namespace fieldbridge::app {
@@ -29,7 +30,7 @@ inline constexpr int exit_port_error = 2;
 struct ScanOptions {
     std::string port;
     std::uint32_t baud = 115200;
-    char parity = 'N';
+    core::Parity parity = core::Parity::none;
     unsigned stop_bits = 1;
     unsigned first = 1;
     /// 247 is the last Modbus address; EXCD203MB (254) and WTEC (253) go further.

@@ -4,55 +4,6 @@
 
 namespace fieldbridge::config {
 
-std::string_view to_string(DeviceType type) noexcept {
-    switch (type) {
-        case DeviceType::hiwin_xeg: return "hiwin-xeg";
-        case DeviceType::excd203mb: return "excd203mb";
-        case DeviceType::wtec_rtu: return "wtec-rtu";
-        case DeviceType::wtec_ascii: return "wtec-ascii";
-        case DeviceType::modbus: return "modbus";
-    }
-    return "unknown";
-}
-
-std::string_view to_string(LogLevel level) noexcept {
-    switch (level) {
-        case LogLevel::trace: return "trace";
-        case LogLevel::debug: return "debug";
-        case LogLevel::info: return "info";
-        case LogLevel::warning: return "warning";
-        case LogLevel::error: return "error";
-    }
-    return "unknown";
-}
-
-std::string_view to_string(Parity parity) noexcept {
-    switch (parity) {
-        case Parity::none: return "none";
-        case Parity::even: return "even";
-        case Parity::odd: return "odd";
-    }
-    return "unknown";
-}
-
-std::string_view to_string(WordOrder order) noexcept {
-    switch (order) {
-        case WordOrder::high_first: return "high_first";
-        case WordOrder::low_first: return "low_first";
-    }
-    return "unknown";
-}
-
-std::string_view to_string(RegisterTable table) noexcept {
-    switch (table) {
-        case RegisterTable::coils: return "coils";
-        case RegisterTable::discrete_inputs: return "discrete_inputs";
-        case RegisterTable::holding: return "holding";
-        case RegisterTable::input: return "input";
-    }
-    return "unknown";
-}
-
 std::string_view to_string(RuleAction action) noexcept {
     switch (action) {
         case RuleAction::allow: return "allow";
@@ -67,16 +18,6 @@ std::string_view to_string(MqttVersion version) noexcept {
         case MqttVersion::v5: return "5";
     }
     return "unknown";
-}
-
-std::optional<DeviceType> parse_device_type(std::string_view text) noexcept {
-    for (const auto type : {DeviceType::hiwin_xeg, DeviceType::excd203mb, DeviceType::wtec_rtu,
-                            DeviceType::wtec_ascii, DeviceType::modbus}) {
-        if (text == to_string(type)) {
-            return type;
-        }
-    }
-    return std::nullopt;
 }
 
 Range<std::uint8_t> address_range(DeviceType type) noexcept {

@@ -19,6 +19,11 @@
 #include <vector>
 
 #include "config/net_address.hpp"
+#include "core/device_type.hpp"
+#include "core/log_level.hpp"
+#include "core/parity.hpp"
+#include "core/register_table.hpp"
+#include "core/word_order.hpp"
 
 namespace fieldbridge::config {
 
@@ -33,27 +38,21 @@ struct Range {
     [[nodiscard]] constexpr bool contains(const T& v) const noexcept { return !(v < min) && !(max < v); }
 };
 
-enum class LogLevel { trace, debug, info, warning, error };
-enum class DeviceType { hiwin_xeg, excd203mb, wtec_rtu, wtec_ascii, modbus };
-enum class Parity { none, even, odd };
-/// Order of the two registers of a 32-bit value.
-enum class WordOrder { high_first, low_first };
-enum class RegisterTable { coils, discrete_inputs, holding, input };
+// The enums the engine, scan and MQTT share are defined once, in core/ (with their
+// one spelling table each); the configuration uses them under its own namespace.
+using core::DeviceType;
+using core::LogLevel;
+using core::Parity;
+using core::RegisterTable;
+using core::to_string;
+using core::WordOrder;
+
 enum class RuleAction { allow, deny };
 enum class MqttVersion { v3_1_1, v5 };
 
-/// The spelling used in the config file (and in MQTT state): "hiwin-xeg", "excd203mb",
-/// "wtec-rtu", "wtec-ascii", "modbus".
-[[nodiscard]] std::string_view to_string(DeviceType type) noexcept;
-[[nodiscard]] std::string_view to_string(LogLevel level) noexcept;
-[[nodiscard]] std::string_view to_string(Parity parity) noexcept;
-[[nodiscard]] std::string_view to_string(WordOrder order) noexcept;
-[[nodiscard]] std::string_view to_string(RegisterTable table) noexcept;
 [[nodiscard]] std::string_view to_string(RuleAction action) noexcept;
 /// "3.1.1" or "5".
 [[nodiscard]] std::string_view to_string(MqttVersion version) noexcept;
-/// The inverse of to_string(DeviceType); nullopt for anything else.
-[[nodiscard]] std::optional<DeviceType> parse_device_type(std::string_view text) noexcept;
 
 /// Bus addresses a device of @p type may have (broadcast addresses excluded):
 /// XEG 1-15 (seed 001 section 2.2: "15 IDs (1~F)"), EXCD203MB 1-254 (seed 002

@@ -34,7 +34,7 @@ namespace {
 
 }  // namespace
 
-ConfigError::ConfigError(std::vector<Diagnostic> d) : std::runtime_error(join_lines(d)), diagnostics_(std::move(d)) {}
+ConfigError::ConfigError(std::vector<Diagnostic> d) : core::Error(join_lines(d)), diagnostics_(std::move(d)) {}
 
 std::vector<Diagnostic> DiagnosticSink::take_sorted() {
     std::stable_sort(diagnostics_.begin(), diagnostics_.end(), [](const Diagnostic& a, const Diagnostic& b) {

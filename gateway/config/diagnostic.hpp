@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::config {
 
 struct Diagnostic {
@@ -22,7 +24,7 @@ struct Diagnostic {
 };
 
 /// Thrown by the loader. what() lists every diagnostic, one per line.
-class ConfigError : public std::runtime_error {
+class ConfigError : public core::Error {
 public:
     explicit ConfigError(std::vector<Diagnostic> d);
     [[nodiscard]] const std::vector<Diagnostic>& diagnostics() const noexcept { return diagnostics_; }

@@ -12,12 +12,7 @@ RawGateway parse_gateway(const NodeRef& ref, DiagnosticSink& sink) {
     RawGateway raw;
     map.fill(raw);
     raw.id = read_string(map, "id");
-    raw.log_level = read_enum<LogLevel>(map, "log_level",
-                                        {{"trace", LogLevel::trace},
-                                         {"debug", LogLevel::debug},
-                                         {"info", LogLevel::info},
-                                         {"warning", LogLevel::warning},
-                                         {"error", LogLevel::error}});
+    raw.log_level = read_enum(map, "log_level", core::log_level_names);
     return raw;
 }
 

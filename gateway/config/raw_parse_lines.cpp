@@ -31,11 +31,7 @@ RawBlock parse_block(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref, {"table", "address", "count", "period", "writable"}, sink);
     RawBlock raw;
     map.fill(raw);
-    raw.table = read_enum<RegisterTable>(map, "table",
-                                         {{"coils", RegisterTable::coils},
-                                          {"discrete_inputs", RegisterTable::discrete_inputs},
-                                          {"holding", RegisterTable::holding},
-                                          {"input", RegisterTable::input}});
+    raw.table = read_enum(map, "table", core::register_table_names);
     raw.address = read_int(map, "address");
     raw.count = read_int(map, "count");
     raw.period = read_duration(map, "period");
@@ -51,12 +47,7 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
     RawDevice raw;
     map.fill(raw);
     raw.name = read_string(map, "name");
-    raw.type = read_enum<DeviceType>(map, "type",
-                                     {{"hiwin-xeg", DeviceType::hiwin_xeg},
-                                      {"excd203mb", DeviceType::excd203mb},
-                                      {"wtec-rtu", DeviceType::wtec_rtu},
-                                      {"wtec-ascii", DeviceType::wtec_ascii},
-                                      {"modbus", DeviceType::modbus}});
+    raw.type = read_enum(map, "type", core::device_type_names);
     raw.address = read_int(map, "address");
     raw.unit_id = read_int(map, "unit_id");
     raw.max_age = read_duration(map, "max_age");
@@ -66,8 +57,7 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
     raw.poll = parse_poll(map.child("poll"), sink);
     raw.allow_protected = read_bool(map, "allow_protected");
     raw.mqtt_commands = read_bool(map, "mqtt_commands");
-    raw.word_order = read_enum<WordOrder>(map, "word_order",
-                                          {{"high_first", WordOrder::high_first}, {"low_first", WordOrder::low_first}});
+    raw.word_order = read_enum(map, "word_order", core::word_order_names);
     raw.stroke = read_int(map, "stroke");
     raw.blocks = read_seq<RawBlock>(map, "blocks", parse_block);
     return raw;
@@ -84,8 +74,7 @@ RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     raw.name = read_string(map, "name");
     raw.port = read_string(map, "port");
     raw.baud = read_int(map, "baud");
-    raw.parity =
-        read_enum<Parity>(map, "parity", {{"none", Parity::none}, {"even", Parity::even}, {"odd", Parity::odd}});
+    raw.parity = read_enum(map, "parity", core::parity_names);
     raw.data_bits = read_int(map, "data_bits");
     raw.stop_bits = read_int(map, "stop_bits");
     raw.rs485 = parse_rs485(map.child("rs485"), sink);

@@ -16,6 +16,7 @@
 #include "config/diagnostic_sink.hpp"
 #include "config/parsed.hpp"
 #include "config/raw_config.hpp"
+#include "core/names.hpp"
 
 namespace fieldbridge::config {
 
@@ -115,10 +116,10 @@ template <class T, class Convert>
 [[nodiscard]] Field<std::string> read_string(const MapReader& map, std::string_view key);
 [[nodiscard]] Field<ListenAddress> read_listen_address(const MapReader& map, std::string_view key);
 
-/// A closed set of spellings; an unknown one is reported with the allowed list.
-template <class E>
-[[nodiscard]] Field<E> read_enum(const MapReader& map, std::string_view key,
-                                 std::initializer_list<std::pair<std::string_view, E>> choices) {
+/// A closed set of spellings (pairs of name and value); an unknown one is reported
+/// with the allowed list.
+template <class E, class Choices>
+[[nodiscard]] Field<E> read_choice(const MapReader& map, std::string_view key, const Choices& choices) {
     std::string allowed;
     for (const auto& [name, value] : choices) {
         allowed += allowed.empty() ? "" : ", ";
@@ -132,6 +133,19 @@ template <class E>
         }
         return Parsed<E>::fail("'" + std::string(text) + "' is not allowed; expected one of: " + allowed);
     });
+}
+
+/// An enum of the configuration only, spelled by @p choices.
+template <class E>
+[[nodiscard]] Field<E> read_enum(const MapReader& map, std::string_view key,
+                                 std::initializer_list<std::pair<std::string_view, E>> choices) {
+    return read_choice<E>(map, key, choices);
+}
+
+/// A shared enum, spelled as its core name table says (core/names.hpp).
+template <class E, std::size_t N>
+[[nodiscard]] Field<E> read_enum(const MapReader& map, std::string_view key, const core::NameTable<E, N>& names) {
+    return read_choice<E>(map, key, names);
 }
 
 /// A list of scalars. A null value reads as an empty list.

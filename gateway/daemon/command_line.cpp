@@ -3,8 +3,11 @@
 #include <CLI/CLI.hpp>
 
 #include <ostream>
+#include <string>
 #include <utility>
+#include <vector>
 
+#include "core/log_level.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
 
@@ -41,10 +44,14 @@ Command CommandLine::parse(int argc, const char* const* argv, std::ostream& out,
     auto* check_option =
         app.add_option("--check-config", check_file, "Validate this configuration file, print every problem, and exit")
             ->type_name("FILE");
+    std::vector<std::string> level_names;
+    for (const auto& [name, level] : core::log_level_names) {
+        level_names.emplace_back(name);
+    }
     auto* level_option =
         app.add_option("-l,--log-level", log_level_text, "Log level, overriding gateway.log_level of the configuration")
             ->type_name("LEVEL")
-            ->check(CLI::IsMember({"trace", "debug", "info", "warning", "error"}));
+            ->check(CLI::IsMember(level_names));
     config_option->excludes(check_option);
     level_option->excludes(check_option);
 
@@ -63,8 +70,8 @@ Command CommandLine::parse(int argc, const char* const* argv, std::ostream& out,
         return ExitCommand{code == static_cast<int>(CLI::ExitCodes::Success) ? exit_ok : exit_usage};
     }
 
-    // Validated by IsMember above, so parse_log_level cannot fail here.
-    const auto log_level = log_level_text.empty() ? std::nullopt : parse_log_level(log_level_text);
+    // Validated by IsMember above, so parse<LogLevel> cannot fail here.
+    const auto log_level = log_level_text.empty() ? std::nullopt : core::parse<core::LogLevel>(log_level_text);
     for (const auto& [command, subcommand] : commands) {
         if (command->parsed()) {
             if (config_option->count() > 0 || check_option->count() > 0) {

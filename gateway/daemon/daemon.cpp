@@ -15,6 +15,7 @@
 #include <asio/post.hpp>
 
 #include "config/diagnostic.hpp"
+#include "core/error.hpp"
 #include "daemon/config_summary.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/logging.hpp"
@@ -69,7 +70,7 @@ Daemon::Daemon(DaemonOptions options, std::shared_ptr<const config::Config> init
       status_refresh_(io_, options_.status_period, [this] { publish_status(false); }),
       readiness_([this] { asio::post(io_, [this] { on_ready(); }); }) {
     if (!config_) {
-        throw std::invalid_argument("Daemon: no initial configuration");
+        throw core::InvalidArgument("Daemon: no initial configuration");
     }
     status_.add([this] { return phase_note(); });
     status_.add([this] { return describe_inventory(*config_); });

@@ -83,15 +83,4 @@ spdlog::level::level_enum to_spdlog_level(config::LogLevel level) noexcept {
     return spdlog::level::info;
 }
 
-std::optional<config::LogLevel> parse_log_level(std::string_view text) noexcept {
-    constexpr std::array levels{config::LogLevel::trace, config::LogLevel::debug, config::LogLevel::info,
-                                config::LogLevel::warning, config::LogLevel::error};
-    for (const auto level : levels) {
-        if (config::to_string(level) == text) {
-            return level;
-        }
-    }
-    return std::nullopt;
-}
-
 }  // namespace fieldbridge::daemon

@@ -50,7 +50,4 @@ enum class LogFormat {
 /// The spdlog level of a configured level (`warning` is spdlog's `warn`).
 [[nodiscard]] spdlog::level::level_enum to_spdlog_level(config::LogLevel level) noexcept;
 
-/// The config spelling ("trace", "debug", "info", "warning", "error") to a level.
-[[nodiscard]] std::optional<config::LogLevel> parse_log_level(std::string_view text) noexcept;
-
 }  // namespace fieldbridge::daemon

@@ -19,15 +19,16 @@
 #include <vector>
 
 #include "config/net_address.hpp"
+#include "core/error.hpp"
 #include "northbound/modbus_tcp/listen_socket.hpp"
 
 namespace fieldbridge::daemon {
 
 /// A start-up error of socket activation (a mismatch between the socket unit and the
 /// configuration); the process exits with exit_config_error.
-class SocketActivationError : public std::runtime_error {
+class SocketActivationError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 /// One file descriptor passed by the service manager.

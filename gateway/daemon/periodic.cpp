@@ -4,12 +4,14 @@
 #include <system_error>
 #include <utility>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::daemon {
 
 Periodic::Periodic(asio::io_context& io, std::chrono::steady_clock::duration period, std::function<void()> tick)
     : timer_(io), period_(period), tick_(std::move(tick)) {
     if (period_ <= std::chrono::steady_clock::duration::zero()) {
-        throw std::invalid_argument("Periodic: the period must be positive");
+        throw core::InvalidArgument("Periodic: the period must be positive");
     }
 }
 

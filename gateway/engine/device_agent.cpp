@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/error.hpp"
 #include "engine/device_agent_answers.hpp"
 #include "engine/device_agent_impl.hpp"
 
@@ -15,7 +16,7 @@ namespace {
 [[nodiscard]] std::unique_ptr<DeviceProfile> checked(std::unique_ptr<DeviceProfile> profile,
                                                      const DeviceAgentConfig& config) {
     if (!profile) {
-        throw std::invalid_argument("device agent '" + config.name + "' on line '" + config.line_name +
+        throw core::InvalidArgument("device agent '" + config.name + "' on line '" + config.line_name +
                                     "': no device profile was given; build one with make_profile()");
     }
     return profile;
@@ -64,7 +65,7 @@ DeviceAgent::Impl::Impl(asio::io_context& io, DeviceAgentConfig config, std::uni
       polls_(profile_->poll_plan(), config_.motion_period, config_.startup_retry),
       poll_timer_(io) {
     if (!submit_) {
-        throw std::invalid_argument("device agent " + who() +
+        throw core::InvalidArgument("device agent " + who() +
                                     ": no submit function; pass the line worker's submit()");
     }
 }
@@ -94,7 +95,7 @@ void DeviceAgent::Impl::shut_down() {
     const std::vector<OperationPtr> pending = std::move(operations_);
     operations_.clear();
     for (const OperationPtr& op : pending) {
-        answer(op, exception_response(op->request, protocol::ExceptionCode::server_device_failure));
+        answer(op, exception_response(op->request, refusal_for(OutcomeStatus::cancelled)));
     }
 }
 

@@ -22,9 +22,11 @@
 ///    so a client never waits forever), each reply applied to the image, and
 ///    respond() builds the answer. A sequence stops at the first payload that fails
 ///    or is answered with a device exception. Outcomes that are not replies map to
-///    Modbus exceptions as spec §4 and §3 rule 9 say: timeout / device_offline /
-///    line_down / expired -> 0x0B (gateway target failed to respond), queue_full ->
-///    0x06 (server busy), cancelled / invalid_request -> 0x04 (server failure).
+///    Modbus exceptions through the gateway's one mapping (refusal_for(),
+///    protocol/gateway_exceptions.hpp; the table in docs/modbus-tcp.md): timeout /
+///    device_offline / expired -> 0x0B, queue_full -> 0x06, line_down and cancelled
+///    (also a sequence the agent's stop() or destruction cut short) -> 0x0A,
+///    invalid_request -> 0x04.
 ///  - A reply's follow_up (XEG exception 0x04 -> FC07) is submitted as an on-demand
 ///    read (one at a time); a DeviceNotice is logged and reported to the notice
 ///    callback.

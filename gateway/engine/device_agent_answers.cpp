@@ -15,8 +15,8 @@ protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept {
         case OutcomeStatus::device_offline: return GatewayRefusal::no_answer;
         case OutcomeStatus::expired: return GatewayRefusal::expired;
         case OutcomeStatus::queue_full: return GatewayRefusal::busy;
-        case OutcomeStatus::line_down:
-        case OutcomeStatus::cancelled: return GatewayRefusal::path_down;
+        case OutcomeStatus::line_down: return GatewayRefusal::path_down;
+        case OutcomeStatus::cancelled: return GatewayRefusal::cancelled;
         case OutcomeStatus::ok:  // an ok outcome without a usable reply
         case OutcomeStatus::broadcast_sent:
         case OutcomeStatus::invalid_request: break;
@@ -27,7 +27,11 @@ protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept {
 ExceptionCode exception_for(OutcomeStatus status) noexcept { return protocol::exception_code(refusal_for(status)); }
 
 protocol::Response exception_response(const protocol::Request& request, ExceptionCode code) {
-    return protocol::ExceptionResponse{protocol::function_of(request), code};
+    return protocol::exception_response(protocol::function_of(request), code);
+}
+
+protocol::Response exception_response(const protocol::Request& request, protocol::GatewayRefusal refusal) {
+    return protocol::exception_response(protocol::function_of(request), refusal);
 }
 
 std::optional<protocol::Response> answer_from_image(const protocol::Request& request, const RegisterImage& image,

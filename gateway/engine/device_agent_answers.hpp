@@ -16,9 +16,10 @@ namespace fieldbridge::engine {
 /// Spec §4 and §3 rule 9, through the gateway's one mapping
 /// (protocol/gateway_exceptions.hpp): timeout / device_offline -> no_answer (0x0B);
 /// expired -> expired (0x0B: a command's deadline passed before it could start);
-/// queue_full -> busy (0x06); line_down / cancelled -> path_down (0x0A: nothing was
-/// sent, the line is down or being shut down or reconfigured); anything else that is
-/// not a reply -> gateway_failure (0x04).
+/// queue_full -> busy (0x06); line_down -> path_down (0x0A: nothing was sent, the
+/// line is down); cancelled -> cancelled (0x0A: the line or the agent was shut down
+/// or reconfigured before the answer came); anything else that is not a reply ->
+/// gateway_failure (0x04).
 [[nodiscard]] protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept;
 [[nodiscard]] protocol::ExceptionCode exception_for(OutcomeStatus status) noexcept;
 
@@ -26,6 +27,8 @@ namespace fieldbridge::engine {
 /// FC16 fails as FC06).
 [[nodiscard]] protocol::Response exception_response(const protocol::Request& request,
                                                     protocol::ExceptionCode code);
+[[nodiscard]] protocol::Response exception_response(const protocol::Request& request,
+                                                    protocol::GatewayRefusal refusal);
 
 /// The answer to an FC01-04 read from @p image when every register asked for is
 /// present, good, and younger than @p max_age (RegisterImage::read_fresh); nullopt

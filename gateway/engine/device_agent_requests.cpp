@@ -24,7 +24,7 @@ void DeviceAgent::Impl::request(const protocol::Request& request, ResponseHandle
     if (state_ == State::stopped) {
         // The agent is being replaced (reconfiguration, shutdown): nothing goes to
         // the line any more, as for a unit whose line is down.
-        post_answer(std::move(done), exception_response(request, ExceptionCode::gateway_path_unavailable));
+        post_answer(std::move(done), exception_response(request, protocol::GatewayRefusal::path_down));
         return;
     }
     // Spec §4: what the profile knows to be invalid costs no line time.
@@ -95,7 +95,7 @@ void DeviceAgent::Impl::on_step_done(const OperationPtr& op, const Outcome& outc
                 image_.mark_stale(span->table, span->address, span->count);
             }
         }
-        answer(op, exception_response(op->request, exception_for(outcome.status)), Delivery::now);
+        answer(op, exception_response(op->request, refusal_for(outcome.status)), Delivery::now);
         return;
     }
     const Payload& sent = op->payloads[op->replies.size()];
@@ -111,7 +111,7 @@ void DeviceAgent::Impl::on_step_done(const OperationPtr& op, const Outcome& outc
         return;
     }
     if (state_ == State::stopped) {
-        answer(op, exception_response(op->request, ExceptionCode::server_device_failure), Delivery::now);
+        answer(op, exception_response(op->request, refusal_for(OutcomeStatus::cancelled)), Delivery::now);
         return;
     }
     submit_step(op);

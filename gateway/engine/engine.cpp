@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "engine/engine_settings.hpp"
 #include "engine/posix_serial_port.hpp"
 #include "engine/profiles/profile_factory.hpp"
@@ -109,14 +110,14 @@ void Engine::set_broadcast(LineEntry& entry, const config::LineConfig& line) {
 std::unique_ptr<DeviceAgent> Engine::build_agent(LineEntry& entry, const config::LineConfig& line,
                                                  const config::DeviceConfig& device) {
     if (entry.next_index == broadcast_device) {
-        throw std::invalid_argument(fmt::format("line {}: no device index left after {} reloads that swapped "
+        throw core::InvalidArgument(fmt::format("line {}: no device index left after {} reloads that swapped "
                                                 "devices; restart the service",
                                                 line.name, entry.next_index));
     }
     const DeviceIndex index = entry.next_index;
     std::unique_ptr<DeviceProfile> profile;
     try {
-        profile = make_profile(to_engine(device.type), profile_options(device));
+        profile = make_profile(device.type, profile_options(device));
     } catch (const ProfileError& error) {
         throw ProfileError(fmt::format("line {}, device {}: {}", line.name, device.name, error.what()));
     }

@@ -81,7 +81,7 @@ struct ReloadReport {
 class Engine {
 public:
     /// Builds every line and device (nothing is opened until start()). Throws
-    /// ProfileError or std::invalid_argument naming the line/device for options the
+    /// ProfileError or core::InvalidArgument naming the line/device for options the
     /// engine cannot use (config validation rejects those first).
     Engine(asio::io_context& io, const config::Config& config, LogSink log, PortFactory ports = posix_port_factory());
     ~Engine();

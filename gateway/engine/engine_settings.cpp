@@ -2,40 +2,11 @@
 
 namespace fieldbridge::engine {
 
-DeviceType to_engine(config::DeviceType type) noexcept {
-    switch (type) {
-        case config::DeviceType::hiwin_xeg: return DeviceType::hiwin_xeg;
-        case config::DeviceType::excd203mb: return DeviceType::excd203mb;
-        case config::DeviceType::wtec_rtu: return DeviceType::wtec_rtu;
-        case config::DeviceType::wtec_ascii: return DeviceType::wtec_ascii;
-        case config::DeviceType::modbus: return DeviceType::modbus;
-    }
-    return DeviceType::modbus;
-}
-
-WordOrder to_engine(config::WordOrder order) noexcept {
-    return order == config::WordOrder::low_first ? WordOrder::low_first : WordOrder::high_first;
-}
-
-Table to_engine(config::RegisterTable table) noexcept {
-    switch (table) {
-        case config::RegisterTable::coils: return Table::coils;
-        case config::RegisterTable::discrete_inputs: return Table::discrete_inputs;
-        case config::RegisterTable::holding: return Table::holding;
-        case config::RegisterTable::input: return Table::input;
-    }
-    return Table::holding;
-}
-
 SerialSettings serial_settings(const config::LineConfig& line) {
     SerialSettings settings;
     settings.path = line.port;
     settings.baud = line.baud;
-    switch (line.parity) {
-        case config::Parity::none: settings.parity = 'N'; break;
-        case config::Parity::even: settings.parity = 'E'; break;
-        case config::Parity::odd: settings.parity = 'O'; break;
-    }
+    settings.parity = line.parity;
     settings.data_bits = line.data_bits;
     settings.stop_bits = line.stop_bits;
     settings.rs485 = line.rs485.enabled;
@@ -50,7 +21,7 @@ LineTimingConfig line_timing(const config::LineConfig& line) {
     LineTimingConfig timing;
     timing.baud = line.baud;
     timing.data_bits = line.data_bits;
-    timing.parity = line.parity != config::Parity::none;
+    timing.parity = line.parity != core::Parity::none;
     timing.stop_bits = line.stop_bits;
     timing.response_timeout = line.response_timeout;
     timing.byte_timeout = line.byte_timeout;
@@ -93,10 +64,10 @@ ProfileOptions profile_options(const config::DeviceConfig& device) {
     options.poll.slow = device.poll.slow;
     options.poll.motion = device.poll.motion;
     options.allow_protected = device.allow_protected;
-    options.word_order = to_engine(device.word_order);
+    options.word_order = device.word_order;
     options.wtec_stroke = device.stroke;
     for (const auto& block : device.blocks) {
-        options.blocks.push_back(GenericBlock{to_engine(block.table), block.address, block.count, block.period,
+        options.blocks.push_back(GenericBlock{block.table, block.address, block.count, block.period,
                                               block.writable});
     }
     return options;

@@ -14,10 +14,6 @@
 
 namespace fieldbridge::engine {
 
-[[nodiscard]] DeviceType to_engine(config::DeviceType type) noexcept;
-[[nodiscard]] WordOrder to_engine(config::WordOrder order) noexcept;
-[[nodiscard]] Table to_engine(config::RegisterTable table) noexcept;
-
 /// Port set-up: path, character format and the kernel RS-485 options.
 [[nodiscard]] SerialSettings serial_settings(const config::LineConfig& line);
 /// Silence, timeouts, turnaround guard, echo, ASCII timeouts (the manual's 5 / 50 ms).

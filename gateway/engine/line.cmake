@@ -2,7 +2,6 @@
 # (timing and framing of the one in flight), wire-time arithmetic. No I/O, no clock.
 add_library(fb_engine_line STATIC
   ${CMAKE_CURRENT_LIST_DIR}/transaction.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/line_log.cpp
   ${CMAKE_CURRENT_LIST_DIR}/line_timing.cpp
   ${CMAKE_CURRENT_LIST_DIR}/line_stats.cpp
   ${CMAKE_CURRENT_LIST_DIR}/line_codec.cpp

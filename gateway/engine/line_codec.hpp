@@ -13,7 +13,7 @@
 namespace fieldbridge::engine {
 
 /// The request on the wire: RTU ADU (address + PDU + CRC) or the WTEC ASCII frame
-/// with CR LF. Throws std::invalid_argument when the codecs refuse the request.
+/// with CR LF. Throws core::InvalidArgument when the codecs refuse the request.
 [[nodiscard]] protocol::Bytes encode_wire_request(const Transaction& transaction);
 
 struct ReplyScan {

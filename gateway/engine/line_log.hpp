@@ -8,11 +8,12 @@
 #include <functional>
 #include <string_view>
 
+#include "core/log_level.hpp"
+
 namespace fieldbridge::engine {
 
-enum class LogLevel : std::uint8_t { debug = 0, info = 1, warning = 2, error = 3 };
-
-[[nodiscard]] const char* to_string(LogLevel level) noexcept;
+using core::LogLevel;
+using core::to_string;
 
 /// Receives one finished message per call. Messages are only built when
 /// enabled(level) is true, so a debug transition log costs nothing when off.

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/error.hpp"
 #include "engine/line_codec.hpp"
 
 namespace fieldbridge::engine {
@@ -128,7 +129,7 @@ void LineMaster::start(Transaction transaction, TimePoint now) {
     std::optional<std::string> refused;
     try {
         request_ = encode_wire_request(*transaction_);
-    } catch (const std::invalid_argument& error) {
+    } catch (const core::InvalidArgument& error) {
         refused = error.what();
     }
     transition(MasterState::waiting_silence, now, "started");

@@ -89,7 +89,7 @@ using LineAction =
 
 class LineMaster {
 public:
-    /// Throws std::invalid_argument for an impossible character format (see LineTiming).
+    /// Throws core::InvalidArgument for an impossible character format (see LineTiming).
     LineMaster(std::string line_name, LineTimingConfig config, LogSink log = {});
 
     /// The port was (re)opened at @p now: the silence counts from here. Counters stay.

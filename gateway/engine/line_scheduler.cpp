@@ -6,6 +6,7 @@
 #include <tuple>
 #include <utility>
 
+#include "core/error.hpp"
 #include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::engine {
@@ -59,21 +60,21 @@ LineScheduler::LineScheduler(SchedulerConfig config, LogSink log)
 void LineScheduler::check_limits(DeviceIndex device, const DeviceLimits& limits) const {
     const std::string where = "line " + config_.line_name + " device " + std::to_string(device);
     if (device == broadcast_device) {
-        throw std::invalid_argument(where + ": index is reserved for broadcasts");
+        throw core::InvalidArgument(where + ": index is reserved for broadcasts");
     }
-    if (limits.queue_limit == 0) throw std::invalid_argument(where + ": queue_limit must be at least 1");
+    if (limits.queue_limit == 0) throw core::InvalidArgument(where + ": queue_limit must be at least 1");
     if (limits.offline_after == 0) {
-        throw std::invalid_argument(where + ": offline_after must be at least 1 timeout");
+        throw core::InvalidArgument(where + ": offline_after must be at least 1 timeout");
     }
     if (limits.backoff_initial <= Duration::zero() || limits.backoff_max < limits.backoff_initial) {
-        throw std::invalid_argument(where + ": offline back-off needs 0 < initial <= max");
+        throw core::InvalidArgument(where + ": offline back-off needs 0 < initial <= max");
     }
 }
 
 void LineScheduler::add_device(DeviceIndex device, DeviceLimits limits, std::string name) {
     check_limits(device, limits);
     if (devices_.count(device) != 0) {
-        throw std::invalid_argument("line " + config_.line_name + " device " + std::to_string(device) +
+        throw core::InvalidArgument("line " + config_.line_name + " device " + std::to_string(device) +
                                     ": added twice");
     }
     Device state;
@@ -87,7 +88,7 @@ void LineScheduler::update_device(DeviceIndex device, DeviceLimits limits) {
     check_limits(device, limits);
     Device* known = find(device);
     if (known == nullptr) {
-        throw std::invalid_argument("line " + config_.line_name + " device " + std::to_string(device) +
+        throw core::InvalidArgument("line " + config_.line_name + " device " + std::to_string(device) +
                                     ": cannot update a device that was never added");
     }
     known->limits = limits;

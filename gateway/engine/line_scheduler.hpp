@@ -120,13 +120,13 @@ class LineScheduler {
 public:
     explicit LineScheduler(SchedulerConfig config, LogSink log = {});
 
-    /// Registers a device (online, empty queue). Throws std::invalid_argument for a
+    /// Registers a device (online, empty queue). Throws core::InvalidArgument for a
     /// duplicate index, broadcast_device, or limits that cannot work (queue_limit 0,
     /// offline_after 0, back-off not positive or max below initial). @p name (the
     /// device's config name) is what the scheduler's log messages call it.
     void add_device(DeviceIndex device, DeviceLimits limits, std::string name = {});
     /// Reload: new limits for a registered device (same checks as add_device); its
-    /// queue, health state and counters stay. Throws std::invalid_argument for an
+    /// queue, health state and counters stay. Throws core::InvalidArgument for an
     /// unknown device.
     void update_device(DeviceIndex device, DeviceLimits limits);
     /// Reload: forgets @p device. Its queued transactions complete with @p status; one

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::engine {
 namespace {
 
@@ -17,14 +19,14 @@ constexpr std::chrono::nanoseconds fixed_t3_5{1'750'000};
 
 LineTiming::LineTiming(CharacterFormat format, InterFrameRule rule) : format_(format), rule_(rule) {
     if (format.baud == 0) {
-        throw std::invalid_argument("line timing: baud rate 0 is not a rate; configure the line's baud");
+        throw core::InvalidArgument("line timing: baud rate 0 is not a rate; configure the line's baud");
     }
     if (format.data_bits < 5 || format.data_bits > 8) {
-        throw std::invalid_argument("line timing: " + std::to_string(format.data_bits) +
+        throw core::InvalidArgument("line timing: " + std::to_string(format.data_bits) +
                                     " data bits is outside 5..8");
     }
     if (format.stop_bits != 1 && format.stop_bits != 2) {
-        throw std::invalid_argument("line timing: " + std::to_string(format.stop_bits) +
+        throw core::InvalidArgument("line timing: " + std::to_string(format.stop_bits) +
                                     " stop bits; use 1 or 2");
     }
     bits_ = 1 + format.data_bits + (format.parity ? 1u : 0u) + format.stop_bits;

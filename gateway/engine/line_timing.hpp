@@ -42,7 +42,7 @@ struct CharacterFormat {
 
 class LineTiming {
 public:
-    /// Throws std::invalid_argument for baud 0, data bits outside 5..8 or stop bits
+    /// Throws core::InvalidArgument for baud 0, data bits outside 5..8 or stop bits
     /// other than 1 or 2 (config validation rejects those earlier).
     explicit LineTiming(CharacterFormat format,
                         InterFrameRule rule = InterFrameRule::per_character);

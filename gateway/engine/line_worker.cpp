@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/error.hpp"
 #include "engine/line_worker_port.hpp"
 
 namespace fieldbridge::engine {
@@ -68,7 +69,7 @@ public:
           reopen_timer_(io),
           reopen_delay_(config_.reopen_initial) {
         if (config_.reopen_initial <= Duration::zero() || config_.reopen_max < config_.reopen_initial) {
-            throw std::invalid_argument("line " + config_.name +
+            throw core::InvalidArgument("line " + config_.name +
                                         ": reopen back-off must be positive with max >= initial");
         }
     }

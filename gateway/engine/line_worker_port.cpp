@@ -4,11 +4,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::engine {
 
 LinePort::LinePort(asio::io_context& io, std::unique_ptr<SerialPort> port)
     : port_(std::move(port)), descriptor_(io) {
-    if (!port_) throw std::invalid_argument("line port: no serial port given");
+    if (!port_) throw core::InvalidArgument("line port: no serial port given");
 }
 
 LinePort::~LinePort() { close(); }

@@ -50,14 +50,14 @@ PosixSerialPort::~PosixSerialPort() { close(); }
 
 void PosixSerialPort::fail(const char* what, int error) {
     close();
-    throw SerialPortError("serial port " + settings_.path + ": " + what + ": " +
-                          std::strerror(error) + " (" + hint_for(error) + ")");
+    throw SerialPortError(std::string(what) + ": " + std::strerror(error), "serial port " + settings_.path,
+                          hint_for(error));
 }
 
 void PosixSerialPort::open() {
     if (is_open()) return;
     modbus_t* raw = modbus_new_rtu(settings_.path.c_str(), static_cast<int>(settings_.baud),
-                                   settings_.parity, static_cast<int>(settings_.data_bits),
+                                   core::parity_letter(settings_.parity), static_cast<int>(settings_.data_bits),
                                    static_cast<int>(settings_.stop_bits));
     if (raw == nullptr) fail("cannot create the port context (invalid settings)", errno);
     ctx_.reset(raw);

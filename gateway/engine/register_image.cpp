@@ -24,16 +24,6 @@ namespace {
 
 }  // namespace
 
-std::string_view to_string(Table table) noexcept {
-    switch (table) {
-        case Table::coils: return "coils";
-        case Table::discrete_inputs: return "discrete_inputs";
-        case Table::holding: return "holding";
-        case Table::input: return "input";
-    }
-    return "unknown";
-}
-
 std::string_view to_string(Quality quality) noexcept {
     switch (quality) {
         case Quality::unknown: return "unknown";

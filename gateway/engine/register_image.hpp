@@ -20,20 +20,17 @@
 #include <string_view>
 #include <vector>
 
+#include "core/register_table.hpp"
 #include "engine/transaction.hpp"
 
 namespace fieldbridge::engine {
 
-/// The four Modbus data tables (Modbus Application Protocol V1.1b3 §4.3).
-enum class Table : std::uint8_t { coils = 0, discrete_inputs = 1, holding = 2, input = 3 };
-inline constexpr std::size_t table_count = 4;
-
-/// "coils", "discrete_inputs", "holding", "input".
-[[nodiscard]] std::string_view to_string(Table table) noexcept;
-/// Bit tables hold 0 / 1 values and are read with FC01 / FC02.
-[[nodiscard]] constexpr bool is_bit_table(Table table) noexcept {
-    return table == Table::coils || table == Table::discrete_inputs;
-}
+/// The four Modbus data tables: the engine's short name for core::RegisterTable (one
+/// definition, core/register_table.hpp), with its names and is_bit_table().
+using Table = core::RegisterTable;
+using core::is_bit_table;
+using core::table_count;
+using core::to_string;
 
 enum class Quality : std::uint8_t {
     unknown,  ///< never read (an address absent from the image)

@@ -10,22 +10,25 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
 #include "engine/serial_low_latency.hpp"
 #include "protocol/bytes.hpp"
+
+#include "core/parity.hpp"
 
 namespace fieldbridge::engine {
 
 /// The port could not be opened or vanished (USB adapter unplugged, pty closed).
 /// what() says which port, what failed and what to check.
-class SerialPortError : public std::runtime_error {
+class SerialPortError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 struct SerialSettings {
     std::string path;
     unsigned baud = 115200;
-    char parity = 'N';  ///< 'N', 'E' or 'O'
+    core::Parity parity = core::Parity::none;
     unsigned data_bits = 8;
     unsigned stop_bits = 1;
     /// Kernel RS-485 mode (TIOCSRS485): the driver switches the transceiver.

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::protocol {
 namespace {
 
@@ -23,7 +25,7 @@ constexpr std::size_t bytes_before_length_payload = unit_offset;
 
 Bytes encode_mbap(std::uint16_t transaction_id, std::uint8_t unit_id, ByteView pdu) {
     if (pdu.empty() || pdu.size() > mbap_max_length - 1U) {
-        throw std::invalid_argument("Modbus TCP frame (transaction " + std::to_string(transaction_id) +
+        throw core::InvalidArgument("Modbus TCP frame (transaction " + std::to_string(transaction_id) +
                                     "): PDU of " + std::to_string(pdu.size()) +
                                     " bytes is outside 1.." + std::to_string(mbap_max_length - 1));
     }

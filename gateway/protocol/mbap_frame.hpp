@@ -22,7 +22,7 @@ struct MbapFrame {
     bool operator==(const MbapFrame&) const = default;
 };
 
-/// Throws std::invalid_argument for an empty PDU or one longer than 253 bytes.
+/// Throws core::InvalidArgument for an empty PDU or one longer than 253 bytes.
 [[nodiscard]] Bytes encode_mbap(std::uint16_t transaction_id, std::uint8_t unit_id, ByteView pdu);
 
 /// Frames the first MBAP frame in a TCP byte stream. need_more until the header

@@ -7,6 +7,7 @@
 #include <string>
 #include <variant>
 
+#include "core/error.hpp"
 #include "protocol/modbus_pdu_detail.hpp"
 
 namespace fieldbridge::protocol {
@@ -24,7 +25,7 @@ std::string function_name(std::uint8_t function) {
 }
 
 void reject(std::uint8_t function, const char* kind, const std::string& what) {
-    throw std::invalid_argument("Modbus " + function_name(function) + " " + kind + ": " + what);
+    throw core::InvalidArgument("Modbus " + function_name(function) + " " + kind + ": " + what);
 }
 
 void check_quantity(std::uint8_t function, const char* kind, const char* field, std::size_t value,

@@ -172,7 +172,7 @@ using Response = std::variant<ReadBitsResponse, ReadRegistersResponse, WriteSing
 /// The exception flag 0x80 is ignored.
 [[nodiscard]] bool is_write(std::uint8_t function) noexcept;
 
-/// Encodes a request PDU. Throws std::invalid_argument when the request breaks a
+/// Encodes a request PDU. Throws core::InvalidArgument when the request breaks a
 /// protocol limit (count 0 or above the maximum, empty write): callers validate first.
 [[nodiscard]] Bytes encode_request(const Request& request);
 
@@ -185,10 +185,10 @@ using Response = std::variant<ReadBitsResponse, ReadRegistersResponse, WriteSing
 /// other than 0xFF00 / 0x0000. Unknown function codes decode as OpaqueRequest.
 [[nodiscard]] DecodeResult<Request> decode_request(ByteView pdu);
 
-/// Encodes a response PDU. Throws std::invalid_argument for a response no device
+/// Encodes a response PDU. Throws core::InvalidArgument for a response no device
 /// may send (function code that does not fit the type, 0 or above the limit values).
 [[nodiscard]] Bytes encode_response(const Response& response);
-/// {function | 0x80, code}. Throws std::invalid_argument unless function is 1..127.
+/// {function | 0x80, code}. Throws core::InvalidArgument unless function is 1..127.
 [[nodiscard]] Bytes encode_exception(std::uint8_t function, ExceptionCode code);
 
 /// Decodes one complete response PDU (exact length) in answer to @p request: the

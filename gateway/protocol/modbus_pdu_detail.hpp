@@ -36,7 +36,7 @@ Overloaded(Ts...) -> Overloaded<Ts...>;
 /// "FC03" style name for messages.
 [[nodiscard]] std::string function_name(std::uint8_t function);
 
-/// Throws std::invalid_argument "Modbus FCxx <kind>: <what>".
+/// Throws core::InvalidArgument "Modbus FCxx <kind>: <what>".
 [[noreturn]] void reject(std::uint8_t function, const char* kind, const std::string& what);
 
 /// Throws unless 1 <= value <= max.

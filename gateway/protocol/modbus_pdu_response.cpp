@@ -3,6 +3,7 @@
 #include <string>
 #include <variant>
 
+#include "protocol/gateway_exceptions.hpp"
 #include "protocol/modbus_pdu.hpp"
 #include "protocol/modbus_pdu_detail.hpp"
 
@@ -183,9 +184,7 @@ Bytes encode_exception(std::uint8_t function, ExceptionCode code) {
     if (function == 0 || (function & fc::exception_flag) != 0) {
         reject(function, "exception", "function code must be 1..127 (without the 0x80 flag)");
     }
-    // 7: the exception reply is the function code with its high bit set, then the code.
-    return Bytes{static_cast<std::uint8_t>(function | fc::exception_flag),
-                 static_cast<std::uint8_t>(code)};
+    return exception_pdu(function, code);
 }
 
 DecodeResult<Response> decode_response(ByteView pdu, const Request& request) {

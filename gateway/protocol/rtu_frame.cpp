@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
 #include "protocol/crc16.hpp"
 
 namespace fieldbridge::protocol {
@@ -120,7 +121,7 @@ bool reply_has_byte_count(std::uint8_t function) noexcept {
 
 Bytes encode_rtu(std::uint8_t address, ByteView pdu) {
     if (pdu.empty() || pdu.size() > max_pdu_size) {
-        throw std::invalid_argument("Modbus-RTU frame for address " + std::to_string(address) +
+        throw core::InvalidArgument("Modbus-RTU frame for address " + std::to_string(address) +
                                     ": PDU of " + std::to_string(pdu.size()) +
                                     " bytes is outside 1.." + std::to_string(max_pdu_size));
     }

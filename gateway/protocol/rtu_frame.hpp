@@ -22,7 +22,7 @@ struct RtuFrame {
     bool operator==(const RtuFrame&) const = default;
 };
 
-/// address + pdu + CRC. Throws std::invalid_argument for an empty PDU or one above
+/// address + pdu + CRC. Throws core::InvalidArgument for an empty PDU or one above
 /// max_pdu_size.
 [[nodiscard]] Bytes encode_rtu(std::uint8_t address, ByteView pdu);
 

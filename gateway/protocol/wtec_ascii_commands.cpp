@@ -5,6 +5,8 @@
 #include <string_view>
 #include <type_traits>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::protocol::wtec {
 
 namespace {
@@ -59,11 +61,11 @@ constexpr std::array<std::string_view, std::variant_size_v<Reply>> reply_names =
     "RunningValues", "Pid", "GripperParams", "DriverParams", "ReleaseParams"};
 
 [[noreturn]] void throw_bad_value(char command, const std::string& what) {
-    throw std::invalid_argument(std::string("WTEC ASCII encode '") + command + "': " + what);
+    throw core::InvalidArgument(std::string("WTEC ASCII encode '") + command + "': " + what);
 }
 
 [[noreturn]] void refuse_reply(char command, const Reply& reply) {
-    throw std::invalid_argument(std::string("WTEC ASCII encode_reply: a ") +
+    throw core::InvalidArgument(std::string("WTEC ASCII encode_reply: a ") +
                                 std::string(reply_names[reply.index()]) +
                                 " reply does not answer command '" + command + "'");
 }

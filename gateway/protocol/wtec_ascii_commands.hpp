@@ -7,7 +7,7 @@
 /// strictly: exact data length per command, hex digits only (upper case, see
 /// wtec_ascii_frame.hpp).
 ///
-/// Encoders throw std::invalid_argument for a value the wire cannot carry (a
+/// Encoders throw core::InvalidArgument for a value the wire cannot carry (a
 /// one-digit field above 0xF, an `E` action outside 1-3, an `i` address outside
 /// 1-253, a reply type that does not answer the command). Decoders return values;
 /// `consumed` is 0 in their results because they take a frame scan_frame already

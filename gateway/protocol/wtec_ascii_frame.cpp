@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/error.hpp"
 #include "protocol/crc16.hpp"
 
 namespace fieldbridge::protocol::wtec {
@@ -36,19 +37,19 @@ constexpr std::size_t max_body_size = max_frame_size - 2;
 
 void check_encodable(const AsciiFrame& frame) {
     if (!is_command_char(frame.command)) {
-        throw std::invalid_argument("WTEC ASCII encode: command byte " +
+        throw core::InvalidArgument("WTEC ASCII encode: command byte " +
                                     std::to_string(static_cast<unsigned char>(frame.command)) +
                                     " is not a letter or '$'");
     }
     if (frame.data.size() > max_data_size) {
-        throw std::invalid_argument(std::string("WTEC ASCII encode: command '") + frame.command +
+        throw core::InvalidArgument(std::string("WTEC ASCII encode: command '") + frame.command +
                                     "' data has " + std::to_string(frame.data.size()) +
                                     " characters, more than the " +
                                     std::to_string(max_data_size) + " a frame can carry");
     }
     for (const char c : frame.data) {
         if (!is_data_char(c)) {
-            throw std::invalid_argument(std::string("WTEC ASCII encode: command '") +
+            throw core::InvalidArgument(std::string("WTEC ASCII encode: command '") +
                                         frame.command + "' data holds byte " +
                                         std::to_string(static_cast<unsigned char>(c)) +
                                         ", which is not printable ASCII or is '>'");

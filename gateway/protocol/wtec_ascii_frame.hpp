@@ -49,7 +49,7 @@ struct AsciiFrame {
 void append_hex(std::string& out, std::uint32_t value, std::size_t width);
 
 /// The full frame text including '>' and the trailing CR LF.
-/// Throws std::invalid_argument when the frame cannot be sent as it is: a command
+/// Throws core::InvalidArgument when the frame cannot be sent as it is: a command
 /// byte that is not a letter or '$', a data character that is not is_data_char, or
 /// data longer than max_data_size.
 [[nodiscard]] std::string encode_frame(const AsciiFrame& frame);

@@ -19,7 +19,7 @@ namespace fieldbridge::scan {
 class LineLink {
 public:
     /// @p port must be open; it is used, not owned, and must outlive the link.
-    /// Throws std::invalid_argument for an impossible character format.
+    /// Throws core::InvalidArgument for an impossible character format.
     LineLink(engine::SerialPort& port, engine::LineTimingConfig timing, engine::LogSink log = {});
 
     /// Sends @p payload to bus address @p address and waits for the outcome: ok with

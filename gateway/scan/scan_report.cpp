@@ -11,14 +11,6 @@ namespace {
 /// configuration, and the comment says to measure the real one.
 constexpr std::uint32_t assumed_wtec_stroke = 20000;
 
-[[nodiscard]] const char* parity_name(char parity) noexcept {
-    switch (parity) {
-        case 'E': return "even";
-        case 'O': return "odd";
-        default: return "none";
-    }
-}
-
 /// Comment text on one line, whatever a device reports.
 [[nodiscard]] std::string one_line(const std::string& text) {
     std::string out;
@@ -41,7 +33,7 @@ std::string config_snippet(const ScannedLine& line, const std::vector<FoundDevic
         << "# Paste under the line's entry in lines[] (docs/configuration.md), with\n"
         << "#   port: " << line.port << "\n"
         << "#   baud: " << line.baud << "\n"
-        << "#   parity: " << parity_name(line.parity) << "\n"
+        << "#   parity: " << core::to_string(line.parity) << "\n"
         << "#   stop_bits: " << line.stop_bits << "\n"
         << "# unit_id is the bus address: renumber when another line uses the same IDs.\n"
         << "devices:\n";

@@ -10,13 +10,15 @@
 
 #include "scan/device_probe.hpp"
 
+#include "core/parity.hpp"
+
 namespace fieldbridge::scan {
 
 /// The line the devices were found on, for the snippet's header comment.
 struct ScannedLine {
     std::string port;
     std::uint32_t baud = 115200;
-    char parity = 'N';  ///< 'N', 'E' or 'O'
+    core::Parity parity = core::Parity::none;
     unsigned stop_bits = 1;
 };
 

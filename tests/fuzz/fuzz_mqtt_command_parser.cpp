@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
+#include "core/error.hpp"
 #include "engine/profiles/excd_profile.hpp"
 #include "engine/profiles/wtec_common.hpp"
 #include "engine/profiles/xeg_profile.hpp"
@@ -56,7 +57,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             bool encodes = true;  // else a parsed command the wire cannot carry
             try {
                 (void)fieldbridge::protocol::encode_request(request);
-            } catch (const std::invalid_argument&) {
+            } catch (const fieldbridge::core::InvalidArgument&) {
                 encodes = false;
             }
             FB_FUZZ_CHECK(encodes);

@@ -24,17 +24,6 @@ namespace {
 std::string hex_byte(std::uint8_t value) { return hex(value, 2); }
 std::string hex_word(std::uint16_t value) { return hex(value, 4); }
 
-std::string_view to_string(DeviceType type) noexcept {
-    switch (type) {
-        case DeviceType::hiwin_xeg: return "hiwin-xeg";
-        case DeviceType::excd203mb: return "excd203mb";
-        case DeviceType::wtec_rtu: return "wtec-rtu";
-        case DeviceType::wtec_ascii: return "wtec-ascii";
-        case DeviceType::modbus: return "modbus";
-    }
-    return "unknown";
-}
-
 std::string_view to_string(Severity severity) noexcept {
     switch (severity) {
         case Severity::warning: return "warning";

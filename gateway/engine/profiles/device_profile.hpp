@@ -21,6 +21,9 @@
 #include <variant>
 #include <vector>
 
+#include "core/device_type.hpp"
+#include "core/error.hpp"
+#include "core/word_order.hpp"
 #include "engine/profiles/operations.hpp"
 #include "engine/profiles/poll_plan.hpp"
 #include "engine/register_image.hpp"
@@ -29,16 +32,11 @@
 
 namespace fieldbridge::engine {
 
-/// The device types of the configuration (spec §5).
-enum class DeviceType : std::uint8_t { hiwin_xeg, excd203mb, wtec_rtu, wtec_ascii, modbus };
-/// The configuration spelling: "hiwin-xeg", "excd203mb", "wtec-rtu", "wtec-ascii", "modbus".
-[[nodiscard]] std::string_view to_string(DeviceType type) noexcept;
+using core::DeviceType;
+using core::to_string;
+using core::WordOrder;
 
 enum class Bus : std::uint8_t { modbus_rtu, wtec_ascii };
-
-/// Order of the two words of a 32-bit pair on the wire (EXCD203MB: seed 002's CRC-
-/// checked solm+ example is high word first; its prose says low word first).
-enum class WordOrder : std::uint8_t { high_first, low_first };
 
 struct PollPeriods {
     Duration fast = milliseconds{50};
@@ -66,9 +64,9 @@ struct ProfileOptions {
 };
 
 /// Options a profile cannot work with; what() names the option and the fix.
-class ProfileError : public std::runtime_error {
+class ProfileError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 /// What a northbound request is (spec §3 rules 2, 4, 5, 6; §4 protected registers).

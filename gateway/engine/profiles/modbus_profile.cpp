@@ -5,6 +5,8 @@
 #include <utility>
 #include <variant>
 
+#include "protocol/gateway_exceptions.hpp"
+
 namespace fieldbridge::engine {
 
 namespace {
@@ -12,7 +14,7 @@ namespace {
 using protocol::ExceptionCode;
 
 [[nodiscard]] protocol::Response failure(std::uint8_t function, ExceptionCode code) {
-    return protocol::ExceptionResponse{function, code};
+    return protocol::exception_response(function, code);
 }
 
 [[nodiscard]] bool is_write_ack(const Reply& reply) {

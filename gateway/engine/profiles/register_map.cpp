@@ -1,5 +1,6 @@
 #include "engine/profiles/register_map.hpp"
 
+#include "core/error.hpp"
 #include "engine/profiles/device_profile.hpp"
 
 #include <algorithm>
@@ -54,7 +55,7 @@ std::optional<RequestSpan> request_span(const protocol::Request& request) {
 RegisterMap::RegisterMap(std::vector<RegisterDef> defs) {
     for (RegisterDef& d : defs) {
         if (d.width < 1 || d.width > 2 || d.count == 0 || d.end() > 0x10000) {
-            throw std::invalid_argument("register map entry '" + d.name + "' at " + std::to_string(d.address) +
+            throw core::InvalidArgument("register map entry '" + d.name + "' at " + std::to_string(d.address) +
                                         ": width must be 1 or 2, count at least 1, and it must end by 0xFFFF");
         }
         tables_[static_cast<std::size_t>(d.table)].push_back(std::move(d));
@@ -64,7 +65,7 @@ RegisterMap::RegisterMap(std::vector<RegisterDef> defs) {
                   [](const RegisterDef& a, const RegisterDef& b) { return a.address < b.address; });
         for (std::size_t i = 1; i < table.size(); ++i) {
             if (table[i - 1].end() > table[i].address) {
-                throw std::invalid_argument("register map entries '" + table[i - 1].name + "' and '" +
+                throw core::InvalidArgument("register map entries '" + table[i - 1].name + "' and '" +
                                             table[i].name + "' overlap at " + std::to_string(table[i].address));
             }
         }

@@ -76,7 +76,7 @@ struct RequestSpan {
 class RegisterMap {
 public:
     RegisterMap() = default;
-    /// Throws std::invalid_argument when entries overlap, have width outside 1-2 or
+    /// Throws core::InvalidArgument when entries overlap, have width outside 1-2 or
     /// count 0, or run past 0xFFFF: a map is written once, in a profile's source.
     explicit RegisterMap(std::vector<RegisterDef> defs);
 

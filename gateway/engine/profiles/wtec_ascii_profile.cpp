@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "engine/profiles/wtec_ascii_image.hpp"
+#include "protocol/gateway_exceptions.hpp"
 #include "engine/profiles/wtec_common.hpp"
 
 namespace fieldbridge::engine {
@@ -133,7 +134,7 @@ void sources_of(Table table, std::uint16_t address, std::array<bool, src_count>&
 }
 
 [[nodiscard]] protocol::Response exception_reply(std::uint8_t function, ExceptionCode code) {
-    return protocol::ExceptionResponse{function, code};
+    return protocol::exception_response(function, code);
 }
 
 }  // namespace

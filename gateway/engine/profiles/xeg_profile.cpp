@@ -71,7 +71,7 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
 }
 
 [[nodiscard]] std::shared_ptr<const RegisterMap> xeg_register_map() {
-    using enum Table;
+    using enum core::RegisterTable;  // clang takes no alias in a using-enum-declaration
     std::vector<RegisterDef> defs{
         reg(discrete_inputs, di_first, "DI", Access::read, 0, 1, 8),
         reg(discrete_inputs, do_first, "DO", Access::read, 0, 1, 8),

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::northbound::metrics {
 
 namespace {
@@ -91,7 +93,7 @@ void check_histogram(std::string_view name, const HistogramValue& value) {
     bool ascending = true;
     for (std::size_t i = 1; i < value.bounds.size(); ++i) ascending = ascending && value.bounds[i - 1] < value.bounds[i];
     if (value.counts.size() != value.bounds.size() + 1 || !ascending) {
-        throw std::invalid_argument("metric " + std::string(name) +
+        throw core::InvalidArgument("metric " + std::string(name) +
                                     ": histogram needs ascending bounds and one count more than bounds");
     }
 }
@@ -124,18 +126,18 @@ std::string format_value(double value) {
 
 MetricSet::Family& MetricSet::family(std::string_view name, std::string_view help, MetricType type,
                                      const Labels& labels) {
-    if (!is_valid_name(name, true)) throw std::invalid_argument("invalid metric name '" + std::string(name) + "'");
+    if (!is_valid_name(name, true)) throw core::InvalidArgument("invalid metric name '" + std::string(name) + "'");
     for (const Label& label : labels) {
         if (!is_valid_name(label.name, false) || label.name.starts_with("__") ||
             (type == MetricType::histogram && label.name == "le")) {
-            throw std::invalid_argument("metric " + std::string(name) + ": invalid label name '" + label.name + "'");
+            throw core::InvalidArgument("metric " + std::string(name) + ": invalid label name '" + label.name + "'");
         }
     }
     const auto found = index_.find(name);
     if (found != index_.end()) {
         Family& existing = families_[found->second];
         if (existing.type != type) {
-            throw std::invalid_argument("metric " + std::string(name) + " added as " + type_name(type) +
+            throw core::InvalidArgument("metric " + std::string(name) + " added as " + type_name(type) +
                                         " but it is a " + type_name(existing.type));
         }
         return existing;
@@ -147,7 +149,7 @@ MetricSet::Family& MetricSet::family(std::string_view name, std::string_view hel
 
 void MetricSet::add_counter(std::string_view name, std::string_view help, Labels labels, double value) {
     if (!name.ends_with("_total")) {
-        throw std::invalid_argument("counter " + std::string(name) + " must end in _total");
+        throw core::InvalidArgument("counter " + std::string(name) + " must end in _total");
     }
     family(name, help, MetricType::counter, labels).samples.push_back(Sample{std::move(labels), value, {}});
 }

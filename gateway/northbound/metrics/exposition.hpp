@@ -45,7 +45,7 @@ struct CounterRow {
 class MetricSet {
 public:
     /// A counter sample; @p name ends in `_total`. Each add_*() throws
-    /// std::invalid_argument for a name or label name Prometheus does not accept, a
+    /// core::InvalidArgument for a name or label name Prometheus does not accept, a
     /// name already used with another type, or a histogram whose counts do not fit
     /// its bounds: a programming error, caught by the unit tests.
     void add_counter(std::string_view name, std::string_view help, Labels labels, double value);

@@ -20,14 +20,15 @@
 #include <asio/io_context.hpp>
 
 #include "config/config.hpp"
+#include "core/error.hpp"
 
 namespace fieldbridge::northbound::metrics {
 
 /// Start-up failures of the endpoint; the message says which address, what failed
 /// and what to do.
-class MetricsHttpError : public std::runtime_error {
+class MetricsHttpError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 struct HttpEndpointLimits {

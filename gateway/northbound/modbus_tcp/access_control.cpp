@@ -80,11 +80,11 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
     return scope;
 }
 
-bool request_allowed(const config::ModbusTcpConfig& config, const config::IpAddress& client, std::uint8_t unit,
+bool request_allowed(const config::ModbusTcpConfig& config, const config::IpAddress& client, core::UnitId unit,
                      const RequestScope& scope) noexcept {
     if (config.rules.empty()) return true;
     const auto allowed = [&](std::optional<config::RegisterRange> range) {
-        return config.decide(client, unit, scope.function, range) == config::RuleAction::allow;
+        return config.decide(client, unit.value, scope.function, range) == config::RuleAction::allow;
     };
     return allowed(scope.first) && (!scope.second || allowed(scope.second));
 }

@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "config/config.hpp"
+#include "core/modbus_ids.hpp"
 #include "protocol/bytes.hpp"
 
 namespace fieldbridge::northbound::modbus_tcp {
@@ -38,6 +39,6 @@ struct RequestScope {
 /// the per-request rule check: the first matching rule decides, no match allows.
 /// FC17 is allowed only when both its read and its write range are allowed.
 [[nodiscard]] bool request_allowed(const config::ModbusTcpConfig& config, const config::IpAddress& client,
-                                   std::uint8_t unit, const RequestScope& scope) noexcept;
+                                   core::UnitId unit, const RequestScope& scope) noexcept;
 
 }  // namespace fieldbridge::northbound::modbus_tcp

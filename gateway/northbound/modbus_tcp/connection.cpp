@@ -24,11 +24,11 @@ using Clock = std::chrono::steady_clock;
 
 /// Appends one MBAP frame (header + PDU) to @p out without a temporary buffer:
 /// responses of one connection are gathered into one write.
-void append_mbap(protocol::Bytes& out, std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
+void append_mbap(protocol::Bytes& out, std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu) {
     protocol::put_u16_be(out, transaction_id);
     protocol::put_u16_be(out, 0);  // protocol identifier: Modbus
     protocol::put_u16_be(out, static_cast<std::uint16_t>(pdu.size() + 1));
-    out.push_back(unit);
+    out.push_back(unit.value);
     out.insert(out.end(), pdu.begin(), pdu.end());
 }
 
@@ -147,7 +147,7 @@ void Connection::process() {
         rx_begin_ += frame.consumed;
         // The next frame's first byte arrived at the latest now.
         last_activity_ = frame_started_ = Clock::now();
-        dispatch(frame.value.transaction_id, frame.value.unit_id, frame.value.pdu);
+        dispatch(frame.value.transaction_id, core::UnitId{frame.value.unit_id}, frame.value.pdu);
     }
     if (closed_ || draining_) return;
     // Keep the partial frame at the front so the buffer always has room for a whole one.
@@ -198,11 +198,12 @@ void Connection::finish_draining() {
     if (draining_ && outstanding_ == 0 && !writing_ && out_pending_.empty()) schedule_close(CloseReason::malformed);
 }
 
-void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
+void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu) {
     ConnectionContext& context = *context_;
     ++context.stats.requests;
     const RequestScope scope = request_scope(pdu);
-    UnitTarget* target = context.routes.find(unit);
+    const core::FunctionCode function{scope.function};
+    UnitTarget* target = context.routes.find(unit.value);
     // A broadcast unit answers for the units of its line: a request it may carry
     // must be allowed for each of them too (docs/modbus-tcp.md, "Broadcast units").
     const auto denied = [&] {
@@ -210,26 +211,26 @@ void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, proto
         if (target == nullptr) return false;
         const std::span<const std::uint8_t> also = target->ruled_as();
         return std::any_of(also.begin(), also.end(), [&](std::uint8_t covered) {
-            return !request_allowed(*context.config, client_.address, covered, scope);
+            return !request_allowed(*context.config, client_.address, core::UnitId{covered}, scope);
         });
     };
     if (denied()) {
         ++context.stats.denied;
         log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} function {} denied by an access rule",
-            peer_, unit, scope.function);
-        respond_exception(transaction_id, unit, scope.function, protocol::GatewayRefusal::denied);
+            peer_, unit.value, function.value);
+        respond_exception(transaction_id, unit, function, protocol::GatewayRefusal::denied);
         return;
     }
     if (target == nullptr) {
         ++context.stats.unknown_unit;
-        log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} has no route", peer_, unit);
-        respond_exception(transaction_id, unit, scope.function, protocol::GatewayRefusal::path_down);
+        log(context.log, LogLevel::debug, "Modbus TCP: client {}: unit {} has no route", peer_, unit.value);
+        respond_exception(transaction_id, unit, function, protocol::GatewayRefusal::path_down);
         return;
     }
-    if (!protocol::is_function_code(scope.function)) {
+    if (!core::is_function_code(function)) {
         // Function byte 0 or >= 0x80 (or an empty PDU): answered here, the same way for
         // every kind of target.
-        respond_exception(transaction_id, unit, scope.function, protocol::GatewayRefusal::not_a_function);
+        respond_exception(transaction_id, unit, function, protocol::GatewayRefusal::not_a_function);
         return;
     }
     const std::uint16_t index = free_slots_.back();
@@ -238,24 +239,24 @@ void Connection::dispatch(std::uint16_t transaction_id, std::uint8_t unit, proto
     slot.busy = true;
     slot.transaction_id = transaction_id;
     slot.unit = unit;
-    slot.function = scope.function;
+    slot.function = function;
     const std::uint32_t generation = slot.generation;
     ++outstanding_;
     forwarded_ = true;
     try {
         // The handler keeps this connection (not its socket: close() releases that)
         // so that an answer arriving after the close is counted and dropped here.
-        target->handle(unit, pdu, client_,
+        target->handle(unit.value, pdu, client_,
                        [self = shared_from_this(), index, generation](protocol::Bytes response) {
                            self->complete(index, generation, std::move(response));
                        });
     } catch (const std::exception& e) {
         ++context.stats.target_failures;
-        log(context.log, LogLevel::error, "Modbus TCP: the target of unit {} failed on a request of {}: {}", unit,
+        log(context.log, LogLevel::error, "Modbus TCP: the target of unit {} failed on a request of {}: {}", unit.value,
             peer_, e.what());
         if (slot.busy && slot.generation == generation) {
             complete(index, generation,
-                     protocol::exception_pdu(scope.function, protocol::GatewayRefusal::gateway_failure));
+                     protocol::exception_pdu(function.value, protocol::GatewayRefusal::gateway_failure));
         }
     }
 }
@@ -278,7 +279,7 @@ void Connection::complete(std::uint16_t index, std::uint32_t generation, protoco
         ++context_->stats.target_failures;
         log(context_->log, LogLevel::error,
             "Modbus TCP: the target of unit {} answered a PDU of {} bytes (1..{} allowed); sending exception 0x04",
-            slot.unit, response_pdu.size(), protocol::max_pdu_size);
+            slot.unit.value, response_pdu.size(), protocol::max_pdu_size);
         respond_exception(slot.transaction_id, slot.unit, slot.function, protocol::GatewayRefusal::gateway_failure);
     } else {
         respond(slot.transaction_id, slot.unit, response_pdu);
@@ -287,12 +288,12 @@ void Connection::complete(std::uint16_t index, std::uint32_t generation, protoco
     finish_draining();
 }
 
-void Connection::respond_exception(std::uint16_t transaction_id, std::uint8_t unit, std::uint8_t function,
+void Connection::respond_exception(std::uint16_t transaction_id, core::UnitId unit, core::FunctionCode function,
                                    protocol::GatewayRefusal refusal) {
-    respond(transaction_id, unit, protocol::exception_pdu(function, refusal));
+    respond(transaction_id, unit, protocol::exception_pdu(function.value, refusal));
 }
 
-void Connection::respond(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu) {
+void Connection::respond(std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu) {
     ServerStats& stats = context_->stats;
     ++stats.responses;
     if (pdu.size() >= 2 && (pdu[0] & protocol::fc::exception_flag) != 0) ++stats.exceptions_by_code[pdu[1]];

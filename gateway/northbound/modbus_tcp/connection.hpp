@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "core/modbus_ids.hpp"
 #include "northbound/modbus_tcp/connection_context.hpp"
 #include "northbound/unit_target.hpp"
 #include "protocol/bytes.hpp"
@@ -74,8 +75,8 @@ private:
     struct Slot {
         std::uint32_t generation = 0;
         std::uint16_t transaction_id = 0;
-        std::uint8_t unit = 0;
-        std::uint8_t function = 0;
+        core::UnitId unit;
+        core::FunctionCode function;
         bool busy = false;
     };
 
@@ -83,10 +84,10 @@ private:
     void on_read(const asio::error_code& error, std::size_t count);
     /// Frames and dispatches buffered requests while slots are free.
     void process();
-    void dispatch(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu);
+    void dispatch(std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu);
     void complete(std::uint16_t slot, std::uint32_t generation, protocol::Bytes response_pdu);
-    void respond(std::uint16_t transaction_id, std::uint8_t unit, protocol::ByteView pdu);
-    void respond_exception(std::uint16_t transaction_id, std::uint8_t unit, std::uint8_t function,
+    void respond(std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu);
+    void respond_exception(std::uint16_t transaction_id, core::UnitId unit, core::FunctionCode function,
                            protocol::GatewayRefusal refusal);
     void write();
     void on_write(const asio::error_code& error);

@@ -4,11 +4,13 @@
 /// Per-request outcomes are never exceptions: they are Modbus exception responses.
 #include <stdexcept>
 
+#include "core/error.hpp"
+
 namespace fieldbridge::northbound::modbus_tcp {
 
-class ModbusTcpError : public std::runtime_error {
+class ModbusTcpError : public core::Error {
 public:
-    using std::runtime_error::runtime_error;
+    using core::Error::Error;
 };
 
 }  // namespace fieldbridge::northbound::modbus_tcp

@@ -4,6 +4,8 @@
 
 #include <asio/post.hpp>
 
+#include "protocol/gateway_exceptions.hpp"
+
 namespace fieldbridge::northbound::mqtt {
 
 SourceState image_state(const engine::DeviceProfile& profile, const engine::RegisterImage& image, bool online) {
@@ -83,7 +85,7 @@ void AgentSource::set_listener(SourceListener listener) {
 }
 
 std::optional<protocol::ExceptionCode> AgentSource::validate(const protocol::Request& request) const {
-    if (agent_ == nullptr) return protocol::ExceptionCode::gateway_path_unavailable;
+    if (agent_ == nullptr) return protocol::exception_code(protocol::GatewayRefusal::path_down);
     return agent_->profile().validate(request, agent_->image());
 }
 
@@ -91,8 +93,7 @@ void AgentSource::execute(const protocol::Request& request, engine::ResponseHand
     if (agent_ == nullptr) {
         const std::uint8_t function = protocol::function_of(request);
         asio::post(io_, [done = std::move(done), function] {
-            done(protocol::Response{
-                protocol::ExceptionResponse{function, protocol::ExceptionCode::gateway_path_unavailable}});
+            done(protocol::Response{protocol::exception_response(function, protocol::GatewayRefusal::path_down)});
         });
         return;
     }

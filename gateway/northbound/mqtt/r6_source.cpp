@@ -5,6 +5,8 @@
 
 #include <asio/post.hpp>
 
+#include "core/error.hpp"
+#include "protocol/gateway_exceptions.hpp"
 #include "northbound/upstream/r6_operations.hpp"
 
 namespace fieldbridge::northbound::mqtt {
@@ -69,11 +71,11 @@ public:
     void detach() noexcept { hub_->target = nullptr; }
 
     std::optional<protocol::ExceptionCode> validate(const protocol::Request& request) const override {
-        if (hub_->target == nullptr) return protocol::ExceptionCode::gateway_path_unavailable;
+        if (hub_->target == nullptr) return protocol::exception_code(protocol::GatewayRefusal::path_down);
         try {
             (void)protocol::encode_request(request);
-        } catch (const std::invalid_argument&) {
-            return protocol::ExceptionCode::illegal_data_value;
+        } catch (const core::InvalidArgument&) {
+            return protocol::exception_code(protocol::GatewayRefusal::bad_value);
         }
         return std::nullopt;
     }
@@ -82,7 +84,7 @@ public:
         const std::uint8_t function = protocol::function_of(request);
         if (hub_->target == nullptr) {
             asio::post(io_, [done = std::move(done), function] {
-                done(protocol::ExceptionResponse{function, protocol::ExceptionCode::gateway_path_unavailable});
+                done(protocol::exception_response(function, protocol::GatewayRefusal::path_down));
             });
             return;
         }
@@ -94,8 +96,8 @@ public:
                                      done(decoded.value);
                                  } else {
                                      // A reply that does not answer the request.
-                                     done(protocol::ExceptionResponse{function,
-                                                                      protocol::ExceptionCode::server_device_failure});
+                                     done(protocol::exception_response(function,
+                                                                       protocol::GatewayRefusal::gateway_failure));
                                  }
                              });
     }

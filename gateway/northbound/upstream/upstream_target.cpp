@@ -30,8 +30,8 @@ protocol::Bytes answer_pdu(std::uint8_t function, const UpstreamOutcome& outcome
         case UpstreamStatus::timeout: return exception_pdu(function, GatewayRefusal::no_answer);
         case UpstreamStatus::expired: return exception_pdu(function, GatewayRefusal::expired);
         case UpstreamStatus::queue_full: return exception_pdu(function, GatewayRefusal::busy);
-        case UpstreamStatus::path_down:
-        case UpstreamStatus::cancelled: break;
+        case UpstreamStatus::cancelled: return exception_pdu(function, GatewayRefusal::cancelled);
+        case UpstreamStatus::path_down: break;
     }
     return exception_pdu(function, GatewayRefusal::path_down);
 }
@@ -133,7 +133,7 @@ public:
             const auto self = weak.lock();
             if (self && outcome.status == UpstreamStatus::ok) {
                 if (self->reply_malformed(unit_id, asked, outcome.response_pdu)) {
-                    done(exception_pdu(function, ExceptionCode::server_device_failure));
+                    done(exception_pdu(function, GatewayRefusal::gateway_failure));
                     return;
                 }
             }

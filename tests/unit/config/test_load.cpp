@@ -379,9 +379,9 @@ TEST_CASE("enum spellings") {
     CHECK(to_string(DeviceType::wtec_ascii) == "wtec-ascii");
     for (const auto type : {DeviceType::hiwin_xeg, DeviceType::excd203mb, DeviceType::wtec_rtu, DeviceType::wtec_ascii,
                             DeviceType::modbus}) {
-        CHECK(parse_device_type(to_string(type)) == type);
+        CHECK(fieldbridge::core::parse<DeviceType>(to_string(type)) == type);
     }
-    CHECK_FALSE(parse_device_type("hiwin_xeg").has_value());
+    CHECK_FALSE(fieldbridge::core::parse<DeviceType>("hiwin_xeg").has_value());
     CHECK(to_string(LogLevel::warning) == "warning");
     CHECK(to_string(MqttVersion::v5) == "5");
     CHECK(to_string(RegisterTable::discrete_inputs) == "discrete_inputs");

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "config/diagnostic.hpp"
 #include "daemon/exit_codes.hpp"
 #include "daemon/status_board.hpp"
@@ -387,7 +388,7 @@ TEST_CASE("signals arrive through the loop: SIGHUP reloads, SIGTERM stops") {
 
 TEST_CASE("misuse is reported") {
     Harness h;
-    CHECK_THROWS_AS(Daemon(h.options, nullptr, h.loader, h.manager, h.logger), std::invalid_argument);
+    CHECK_THROWS_AS(Daemon(h.options, nullptr, h.loader, h.manager, h.logger), fieldbridge::core::InvalidArgument);
     auto& daemon = h.create();
     h.manager.on_notify = [&](const std::string& message) {
         if (starts_with(message, "READY=1")) {

@@ -123,14 +123,14 @@ TEST_CASE("the journal format is chosen only when the fd is the journal stream")
 }
 
 TEST_CASE("log levels: config spelling and spdlog mapping") {
-    CHECK(daemon_ns::parse_log_level("trace") == LogLevel::trace);
-    CHECK(daemon_ns::parse_log_level("debug") == LogLevel::debug);
-    CHECK(daemon_ns::parse_log_level("info") == LogLevel::info);
-    CHECK(daemon_ns::parse_log_level("warning") == LogLevel::warning);
-    CHECK(daemon_ns::parse_log_level("error") == LogLevel::error);
-    CHECK_FALSE(daemon_ns::parse_log_level("warn").has_value());
-    CHECK_FALSE(daemon_ns::parse_log_level("INFO").has_value());
-    CHECK_FALSE(daemon_ns::parse_log_level("").has_value());
+    CHECK(fieldbridge::core::parse<LogLevel>("trace") == LogLevel::trace);
+    CHECK(fieldbridge::core::parse<LogLevel>("debug") == LogLevel::debug);
+    CHECK(fieldbridge::core::parse<LogLevel>("info") == LogLevel::info);
+    CHECK(fieldbridge::core::parse<LogLevel>("warning") == LogLevel::warning);
+    CHECK(fieldbridge::core::parse<LogLevel>("error") == LogLevel::error);
+    CHECK_FALSE(fieldbridge::core::parse<LogLevel>("warn").has_value());
+    CHECK_FALSE(fieldbridge::core::parse<LogLevel>("INFO").has_value());
+    CHECK_FALSE(fieldbridge::core::parse<LogLevel>("").has_value());
 
     CHECK(daemon_ns::to_spdlog_level(LogLevel::trace) == spdlog::level::trace);
     CHECK(daemon_ns::to_spdlog_level(LogLevel::debug) == spdlog::level::debug);

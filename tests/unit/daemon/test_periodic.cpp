@@ -7,6 +7,7 @@
 #include <asio/io_context.hpp>
 #include <asio/post.hpp>
 
+#include "core/error.hpp"
 #include "daemon/periodic.hpp"
 
 using fieldbridge::daemon::Periodic;
@@ -97,5 +98,5 @@ TEST_CASE("a stalled loop does not produce a burst of ticks") {
 
 TEST_CASE("a non-positive period is refused") {
     asio::io_context io;
-    CHECK_THROWS_AS(Periodic(io, 0ms, [] {}), std::invalid_argument);
+    CHECK_THROWS_AS(Periodic(io, 0ms, [] {}), fieldbridge::core::InvalidArgument);
 }

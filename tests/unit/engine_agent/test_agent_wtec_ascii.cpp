@@ -164,14 +164,14 @@ TEST_CASE("agent wtec ascii: initialise sends a1 then G") {
     CHECK(rig.last_answer() == fp::Response{fp::WriteSingleResponse{fp::fc::write_single_register, 0x0100, 1}});
 }
 
-TEST_CASE("agent wtec ascii: stop() between payloads ends the sequence with 0x04") {
+TEST_CASE("agent wtec ascii: stop() between payloads ends the sequence as cancelled, 0x0A") {
     Wtec rig;
     rig.request(force_speed_position);
     const auto sent = commands(rig.line);
     rig.agent->stop();
     rig.line.reply(sent[0], ascii_reply(rig.line.at(sent[0]), fw::Ack{}));
     rig.await_answers(1);
-    CHECK(rig.last_answer() == exception(fp::fc::write_multiple_registers, ExceptionCode::server_device_failure));
+    CHECK(rig.last_answer() == exception(fp::fc::write_multiple_registers, ExceptionCode::gateway_path_unavailable));
     CHECK(commands(rig.line).size() == 1);
     CHECK(rig.agent->image().value(Table::input, 0x1008) == 100);  // the C reply still landed
 }

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/error.hpp"
 #include "line_test_support.hpp"
 
 namespace {
@@ -420,18 +421,18 @@ TEST_CASE("scheduler: an unknown device is refused, device setup is checked") {
     Recorder r;
     s.submit(tagged(read_tx(7, 1, Priority::poll), r, "ghost"), t0);
     CHECK(r.status("ghost") == OutcomeStatus::invalid_request);
-    CHECK_THROWS_AS(s.add_device(0, {}), std::invalid_argument);
-    CHECK_THROWS_AS(s.add_device(fe::broadcast_device, {}), std::invalid_argument);
+    CHECK_THROWS_AS(s.add_device(0, {}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS(s.add_device(fe::broadcast_device, {}), fieldbridge::core::InvalidArgument);
     fe::DeviceLimits bad;
     bad.queue_limit = 0;
-    CHECK_THROWS_AS(s.add_device(1, bad), std::invalid_argument);
+    CHECK_THROWS_AS(s.add_device(1, bad), fieldbridge::core::InvalidArgument);
     bad = {};
     bad.offline_after = 0;
-    CHECK_THROWS_AS(s.add_device(1, bad), std::invalid_argument);
+    CHECK_THROWS_AS(s.add_device(1, bad), fieldbridge::core::InvalidArgument);
     bad = {};
     bad.backoff_max = bad.backoff_initial / 2;
     CHECK_THROWS_WITH_AS(s.add_device(1, bad), doctest::Contains("line A device 1"),
-                         std::invalid_argument);
+                         fieldbridge::core::InvalidArgument);
     CHECK_FALSE(s.has_device(1));
 }
 

@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "engine/line_stats.hpp"
 #include "engine/line_timing.hpp"
 #include "engine/transaction.hpp"
@@ -64,11 +65,11 @@ TEST_CASE("timing: the Modbus fixed timers apply above 19200 bit/s only, and onl
 
 TEST_CASE("timing: impossible formats are refused with the reason") {
     CHECK_THROWS_WITH_AS(fe::LineTiming({0, 8, false, 1}), doctest::Contains("baud"),
-                         std::invalid_argument);
+                         fieldbridge::core::InvalidArgument);
     CHECK_THROWS_WITH_AS(fe::LineTiming({9600, 8, false, 3}), doctest::Contains("stop bits"),
-                         std::invalid_argument);
+                         fieldbridge::core::InvalidArgument);
     CHECK_THROWS_WITH_AS(fe::LineTiming({9600, 9, false, 1}), doctest::Contains("data bits"),
-                         std::invalid_argument);
+                         fieldbridge::core::InvalidArgument);
 }
 
 TEST_CASE("timing: the line config maps to the character format") {

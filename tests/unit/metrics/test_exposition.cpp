@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "northbound/metrics/exposition.hpp"
 
 namespace fieldbridge::northbound::metrics {
@@ -90,18 +91,18 @@ TEST_CASE("values: shortest decimal, no exponent for ordinary magnitudes, specia
 
 TEST_CASE("names Prometheus would refuse are programming errors") {
     MetricSet set;
-    CHECK_THROWS_AS(set.add_gauge("1bad", "h", {}, 1), std::invalid_argument);
-    CHECK_THROWS_AS(set.add_gauge("fb-bad", "h", {}, 1), std::invalid_argument);
-    CHECK_THROWS_AS(set.add_gauge("fb_g", "h", {{"bad-label", "v"}}, 1), std::invalid_argument);
-    CHECK_THROWS_AS(set.add_gauge("fb_g", "h", {{"__reserved", "v"}}, 1), std::invalid_argument);
-    CHECK_THROWS_AS(set.add_counter("fb_requests", "h", {}, 1), std::invalid_argument);  // no _total
+    CHECK_THROWS_AS(set.add_gauge("1bad", "h", {}, 1), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS(set.add_gauge("fb-bad", "h", {}, 1), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS(set.add_gauge("fb_g", "h", {{"bad-label", "v"}}, 1), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS(set.add_gauge("fb_g", "h", {{"__reserved", "v"}}, 1), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS(set.add_counter("fb_requests", "h", {}, 1), fieldbridge::core::InvalidArgument);  // no _total
     CHECK_THROWS_AS(set.add_histogram("fb_h", "h", {{"le", "1"}}, HistogramValue{{1.0}, {0, 0}, 0}),
-                    std::invalid_argument);
-    CHECK_THROWS_AS(set.add_histogram("fb_h", "h", {}, HistogramValue{{1.0}, {0}, 0}), std::invalid_argument);
+                    fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS(set.add_histogram("fb_h", "h", {}, HistogramValue{{1.0}, {0}, 0}), fieldbridge::core::InvalidArgument);
     CHECK_THROWS_AS(set.add_histogram("fb_h", "h", {}, HistogramValue{{2.0, 1.0}, {0, 0, 0}, 0}),
-                    std::invalid_argument);
+                    fieldbridge::core::InvalidArgument);
     set.add_gauge("fb_mixed_total", "h", {}, 1);
-    CHECK_THROWS_AS(set.add_counter("fb_mixed_total", "h", {}, 1), std::invalid_argument);  // one type per name
+    CHECK_THROWS_AS(set.add_counter("fb_mixed_total", "h", {}, 1), fieldbridge::core::InvalidArgument);  // one type per name
 }
 
 }  // namespace

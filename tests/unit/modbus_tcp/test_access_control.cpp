@@ -11,6 +11,7 @@ namespace fieldbridge::northbound::modbus_tcp {
 namespace {
 
 using config::RegisterRange;
+using core::UnitId;
 using protocol::Bytes;
 
 [[nodiscard]] config::IpAddress ip(const char* text) { return *config::parse_ip_address(text); }
@@ -61,7 +62,7 @@ TEST_CASE("request_scope: a malformed quantity never shrinks the range") {
 
 TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges allowed") {
     config::ModbusTcpConfig config;
-    CHECK(request_allowed(config, ip("10.0.0.1"), 1, request_scope(Bytes{0x06, 0, 1, 0, 1})));  // no rules
+    CHECK(request_allowed(config, ip("10.0.0.1"), UnitId{1}, request_scope(Bytes{0x06, 0, 1, 0, 1})));  // no rules
 
     config::AccessRule plc_writes;  // the PLC may write registers 0x100-0x1FF of unit 1
     plc_writes.clients = {test::cidr("10.0.0.5")};
@@ -76,20 +77,20 @@ TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges 
 
     const auto plc = ip("10.0.0.5");
     const auto scada = ip("10.0.0.9");
-    CHECK(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));
-    CHECK_FALSE(request_allowed(config, plc, 2, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));   // other unit
-    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x00, 0x10, 0, 1})));   // outside
-    CHECK_FALSE(request_allowed(config, scada, 1, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));  // not the PLC
-    CHECK(request_allowed(config, scada, 1, request_scope(Bytes{0x03, 0x01, 0x10, 0, 1})));        // reads pass
+    CHECK(request_allowed(config, plc, UnitId{1}, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));
+    CHECK_FALSE(request_allowed(config, plc, UnitId{2}, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));   // other unit
+    CHECK_FALSE(request_allowed(config, plc, UnitId{1}, request_scope(Bytes{0x06, 0x00, 0x10, 0, 1})));   // outside
+    CHECK_FALSE(request_allowed(config, scada, UnitId{1}, request_scope(Bytes{0x06, 0x01, 0x10, 0, 1})));  // not the PLC
+    CHECK(request_allowed(config, scada, UnitId{1}, request_scope(Bytes{0x03, 0x01, 0x10, 0, 1})));        // reads pass
     // Allow needs containment: a write reaching past 0x1FF is denied.
-    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x10, 0x01, 0xFF, 0, 2, 4, 0, 1, 0, 2})));
+    CHECK_FALSE(request_allowed(config, plc, UnitId{1}, request_scope(Bytes{0x10, 0x01, 0xFF, 0, 2, 4, 0, 1, 0, 2})));
     // FC17 of the PLC: the read range outside its allow rule falls to the deny rule.
     const Bytes rw_inside{0x17, 0x01, 0x00, 0x00, 0x01, 0x01, 0x10, 0x00, 0x01, 0x02, 0x00, 0x01};
     const Bytes rw_read_outside{0x17, 0x00, 0x00, 0x00, 0x01, 0x01, 0x10, 0x00, 0x01, 0x02, 0x00, 0x01};
-    CHECK(request_allowed(config, plc, 1, request_scope(rw_inside)));
-    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(rw_read_outside)));
+    CHECK(request_allowed(config, plc, UnitId{1}, request_scope(rw_inside)));
+    CHECK_FALSE(request_allowed(config, plc, UnitId{1}, request_scope(rw_read_outside)));
     // A truncated write may touch anything: the allow rule (with a range) cannot match it.
-    CHECK_FALSE(request_allowed(config, plc, 1, request_scope(Bytes{0x06, 0x01})));
+    CHECK_FALSE(request_allowed(config, plc, UnitId{1}, request_scope(Bytes{0x06, 0x01})));
 }
 
 TEST_CASE("a deny rule matches any overlap with its register range") {
@@ -99,14 +100,14 @@ TEST_CASE("a deny rule matches any overlap with its register range") {
     protect.action = config::RuleAction::deny;
     config.rules = {protect};
     const auto client = ip("192.168.1.2");
-    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x20})));
-    CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x10})));  // ends at 0x1FF
-    CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x07})));  // no registers: no match
+    CHECK_FALSE(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x20})));
+    CHECK(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x03, 0x01, 0xF0, 0x00, 0x10})));  // ends at 0x1FF
+    CHECK(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x07})));  // no registers: no match
     // Fail closed: FC22 in the range, and what the server cannot derive, are denied.
-    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x16, 0x02, 0x01, 0xFF, 0xFF, 0, 1})));
-    CHECK(request_allowed(config, client, 7, request_scope(Bytes{0x16, 0x02, 0x04, 0xFF, 0xFF, 0, 1})));
-    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x15, 0x07, 0x06, 0, 1, 0, 0, 0, 1})));
-    CHECK_FALSE(request_allowed(config, client, 7, request_scope(Bytes{0x41, 0x00})));
+    CHECK_FALSE(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x16, 0x02, 0x01, 0xFF, 0xFF, 0, 1})));
+    CHECK(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x16, 0x02, 0x04, 0xFF, 0xFF, 0, 1})));
+    CHECK_FALSE(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x15, 0x07, 0x06, 0, 1, 0, 0, 0, 1})));
+    CHECK_FALSE(request_allowed(config, client, UnitId{7}, request_scope(Bytes{0x41, 0x00})));
 }
 
 TEST_CASE("UnitRouter: set, replace, remove, distinct targets") {

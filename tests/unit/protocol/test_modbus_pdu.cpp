@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "protocol/modbus_pdu.hpp"
 #include "vectors.hpp"
 
@@ -249,7 +250,7 @@ TEST_CASE("pdu: encode_request rejects what breaks a protocol limit") {
     };
     for (std::size_t i = 0; i < invalid.size(); ++i) {
         CAPTURE(i);
-        CHECK_THROWS_AS((void)p::encode_request(invalid[i]), std::invalid_argument);
+        CHECK_THROWS_AS((void)p::encode_request(invalid[i]), fieldbridge::core::InvalidArgument);
     }
     CHECK_THROWS_WITH((void)p::encode_request(p::ReadRegistersRequest{0x03, 0, 126}),
                       doctest::Contains("FC03 request: register count 126 is outside 1..125"));
@@ -277,8 +278,8 @@ TEST_CASE("pdu: responses encode and decode both ways") {
         }
     }
     CHECK(p::encode_exception(0x03, p::ExceptionCode::illegal_data_address) == Bytes{0x83, 0x02});
-    CHECK_THROWS_AS((void)p::encode_exception(0x83, p::ExceptionCode::illegal_function), std::invalid_argument);
-    CHECK_THROWS_AS((void)p::encode_exception(0x00, p::ExceptionCode::illegal_function), std::invalid_argument);
+    CHECK_THROWS_AS((void)p::encode_exception(0x83, p::ExceptionCode::illegal_function), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)p::encode_exception(0x00, p::ExceptionCode::illegal_function), fieldbridge::core::InvalidArgument);
 }
 
 TEST_CASE("pdu: a response truncated at every length is never complete") {
@@ -355,7 +356,7 @@ TEST_CASE("pdu: encode_response rejects responses no device may send") {
     };
     for (std::size_t i = 0; i < invalid.size(); ++i) {
         CAPTURE(i);
-        CHECK_THROWS_AS((void)p::encode_response(invalid[i]), std::invalid_argument);
+        CHECK_THROWS_AS((void)p::encode_response(invalid[i]), fieldbridge::core::InvalidArgument);
     }
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "protocol/crc16.hpp"
 #include "protocol/rtu_frame.hpp"
 #include "vectors.hpp"
@@ -95,8 +96,8 @@ TEST_CASE("rtu: encode_rtu puts the CRC low byte first") {
     CHECK(p::encode_rtu(0x02, Bytes{0x86, 0x02}) == exception_reply);
     CHECK(p::encode_rtu(0x02, Bytes{0x07}) == Bytes{0x02, 0x07, 0x41, 0x12});
     CHECK(p::encode_rtu(0xF7, Bytes(p::max_pdu_size, 0x41)).size() == p::max_rtu_adu_size);
-    CHECK_THROWS_AS((void)p::encode_rtu(0x02, Bytes{}), std::invalid_argument);
-    CHECK_THROWS_AS((void)p::encode_rtu(0x02, Bytes(p::max_pdu_size + 1, 0x41)), std::invalid_argument);
+    CHECK_THROWS_AS((void)p::encode_rtu(0x02, Bytes{}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)p::encode_rtu(0x02, Bytes(p::max_pdu_size + 1, 0x41)), fieldbridge::core::InvalidArgument);
 }
 
 TEST_CASE("rtu: decode_rtu boundaries") {

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/error.hpp"
 #include "protocol/wtec_ascii_commands.hpp"
 #include "wtec_test_support.hpp"
 
@@ -310,29 +311,29 @@ TEST_CASE("wtec commands: W padding is encoded as zeros and accepted as any hex"
 TEST_CASE("wtec commands: encoders refuse values the wire cannot carry") {
     auto bad_homing = homing;
     bad_homing.sensor_mode = 0x10;
-    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteHoming{bad_homing}), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadHoming{}, bad_homing), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteHoming{bad_homing}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadHoming{}, bad_homing), fieldbridge::core::InvalidArgument);
     auto bad_gripper = gripper;
     bad_gripper.home_at_power_up = 0x10;
-    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteGripper{bad_gripper}), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteGripper{bad_gripper}), fieldbridge::core::InvalidArgument);
     auto bad_driver = driver;
     bad_driver.multi_turn = 0x10;
-    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteDriver{bad_driver}), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteDriver{bad_driver}), fieldbridge::core::InvalidArgument);
     bad_driver = driver;
     bad_driver.damping = 0xFF;
-    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteDriver{bad_driver}), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::WriteDriver{bad_driver}), fieldbridge::core::InvalidArgument);
     CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::GripperAction{static_cast<wtec::GripAction>(7)}),
-                    std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::SetAddress{0}), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::SetAddress{0xFE}), std::invalid_argument);
+                    fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::SetAddress{0}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_command(1, wtec::SetAddress{0xFE}), fieldbridge::core::InvalidArgument);
     // A reply type that does not answer the command.
-    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadPid{}, wtec::Ack{}), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::Home{}, pid), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::Home{}, wtec::NotExecuted{}), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadPid{}, wtec::Ack{}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::Home{}, pid), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::Home{}, wtec::NotExecuted{}), fieldbridge::core::InvalidArgument);
     CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadVersion{}, wtec::Version{"1.62"}),
-                    std::invalid_argument);
+                    fieldbridge::core::InvalidArgument);
     CHECK_THROWS_AS((void)wtec::encode_reply(1, wtec::ReadStations{}, wtec::Station{2}),
-                    std::invalid_argument);
+                    fieldbridge::core::InvalidArgument);
 }
 
 TEST_CASE("wtec commands: fixed-seed fuzz through scan, decode_command and decode_reply") {

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/error.hpp"
 #include "protocol/wtec_ascii_frame.hpp"
 #include "wtec_test_support.hpp"
 
@@ -78,12 +79,12 @@ TEST_CASE("wtec frame: encode matches the manual's frames") {
 }
 
 TEST_CASE("wtec frame: encode refuses what cannot be sent") {
-    CHECK_THROWS_AS((void)wtec::encode_frame({1, '1', ""}), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_frame({1, '\0', ""}), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_frame({1, 'A', "a>b"}), std::invalid_argument);
-    CHECK_THROWS_AS((void)wtec::encode_frame({1, 'A', "a\rb"}), std::invalid_argument);
+    CHECK_THROWS_AS((void)wtec::encode_frame({1, '1', ""}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_frame({1, '\0', ""}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_frame({1, 'A', "a>b"}), fieldbridge::core::InvalidArgument);
+    CHECK_THROWS_AS((void)wtec::encode_frame({1, 'A', "a\rb"}), fieldbridge::core::InvalidArgument);
     CHECK_THROWS_AS((void)wtec::encode_frame({1, 'A', std::string(wtec::max_data_size + 1, '0')}),
-                    std::invalid_argument);
+                    fieldbridge::core::InvalidArgument);
     // The largest frame is exactly max_frame_size characters and scans back.
     const std::string largest = wtec::encode_frame({1, 'A', std::string(wtec::max_data_size, '7')});
     CHECK(largest.size() == wtec::max_frame_size);

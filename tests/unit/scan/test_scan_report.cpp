@@ -26,7 +26,7 @@ TEST_CASE("the snippet lists every device with name, type, address and unit_id, 
         {3, DeviceType::excd203mb, "ver (0x0207-0x0208) reads 120", true},
         {4, DeviceType::wtec_rtu, "device ID register 0x0303 reads 4", false},
     };
-    const std::string text = config_snippet(ScannedLine{"/dev/ttyUSB0", 57600, 'E', 2}, devices);
+    const std::string text = config_snippet(ScannedLine{"/dev/ttyUSB0", 57600, fieldbridge::core::Parity::even, 2}, devices);
     CHECK(contains(text, "#   port: /dev/ttyUSB0\n#   baud: 57600\n#   parity: even\n#   stop_bits: 2\n"));
     CHECK(contains(text, "\ndevices:\n  - name: hiwin-xeg-2\n    # XEG-32 (model 0x0A20)\n    type: hiwin-xeg\n"
                          "    address: 2\n    unit_id: 2\n  - name: excd203mb-3\n"));
@@ -37,7 +37,7 @@ TEST_CASE("the snippet lists every device with name, type, address and unit_id, 
 }
 
 TEST_CASE("wtec-ascii gets the required stroke with a note to measure it") {
-    const std::string text = config_snippet(ScannedLine{"/dev/ttyS1", 115200, 'N', 1},
+    const std::string text = config_snippet(ScannedLine{"/dev/ttyS1", 115200, fieldbridge::core::Parity::none, 1},
                                             {{5, DeviceType::wtec_ascii, "firmware \"Cstep [A]1.62\"", false}});
     CHECK(contains(text, "#   parity: none\n"));
     CHECK(contains(text, "    type: wtec-ascii\n    address: 5\n    unit_id: 5\n"));
@@ -46,7 +46,7 @@ TEST_CASE("wtec-ascii gets the required stroke with a note to measure it") {
 }
 
 TEST_CASE("a generic device gets a block, and text a device sent cannot break a line") {
-    const std::string text = config_snippet(ScannedLine{"/dev/ttyS1", 9600, 'O', 1},
+    const std::string text = config_snippet(ScannedLine{"/dev/ttyS1", 9600, fieldbridge::core::Parity::odd, 1},
                                             {{40, DeviceType::modbus, "odd\ntext", true}});
     CHECK(contains(text, "#   parity: odd\n"));
     CHECK(contains(text, "    # odd text\n"));
