@@ -142,6 +142,15 @@ int run(double run_seconds, int write_count) {
                 "(user %.1f + kernel %.1f)\n",
                 static_cast<unsigned long long>(floor.transactions), floor.seconds, floor_tps, floor_tps / limit_tps,
                 static_cast<unsigned long long>(floor.timeouts), floor_cpu, floor.user_cpu_us, floor.sys_cpu_us);
+    // The simulator's wire time as a client sees it (request, 3.5-character silence,
+    // turnaround, reply): the precise figure of tests/integration/sim/test_wire_time.py,
+    // whose sanitizer build asserts an order of magnitude only.
+    const double ideal_reply =
+        t_read - duration<double, std::milli>(timing.t3_5()).count();  // without the silence after the reply
+    std::printf("floor reply time: ideal %.3f ms; median %.3f ms (+%.0f us, target < +2000 us), "
+                "p99 %.3f ms (+%.0f us)\n",
+                ideal_reply, floor.reply_median_ms, (floor.reply_median_ms - ideal_reply) * 1e3, floor.reply_p99_ms,
+                (floor.reply_p99_ms - ideal_reply) * 1e3);
 
     EngineHarness h(engine_yaml(sim.path("line-a")));
     h.start();

@@ -7,10 +7,12 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <vector>
 
 #include "engine/line_timing.hpp"
 #include "process_cpu.hpp"
@@ -66,7 +68,9 @@ RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, st
     const auto start = Clock::now();
     const auto end = start + std::chrono::duration_cast<Clock::duration>(duration);
     std::array<std::uint8_t, 256> buffer{};
+    std::vector<double> reply_ms;
     while (Clock::now() < end) {
+        const auto sent = Clock::now();
         if (::write(port.fd(), request.data(), request.size()) != static_cast<ssize_t>(request.size())) {
             throw std::runtime_error("raw master: write to " + path + " failed: " + std::strerror(errno));
         }
@@ -79,6 +83,7 @@ RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, st
         }
         if (got == reply_size) {
             ++result.transactions;
+            reply_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - sent).count());
         } else {
             ++result.timeouts;
         }
@@ -90,6 +95,9 @@ RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, st
         const auto n = static_cast<double>(result.transactions);
         result.user_cpu_us = (cpu1.user - cpu0.user) * 1e6 / n;
         result.sys_cpu_us = (cpu1.sys - cpu0.sys) * 1e6 / n;
+        std::sort(reply_ms.begin(), reply_ms.end());
+        result.reply_median_ms = reply_ms[reply_ms.size() / 2];
+        result.reply_p99_ms = reply_ms[std::min(reply_ms.size() - 1, reply_ms.size() * 99 / 100)];
     }
     return result;
 }

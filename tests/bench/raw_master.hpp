@@ -20,6 +20,10 @@ struct RawMasterResult {
     double seconds = 0.0;
     double user_cpu_us = 0.0;  ///< per transaction
     double sys_cpu_us = 0.0;   ///< per transaction
+    /// From before the request's write to the reply's last byte read, over the
+    /// transactions answered: what a client sees of the simulator's wire time.
+    double reply_median_ms = 0.0;
+    double reply_p99_ms = 0.0;
 };
 
 /// Runs FC04 @p reg x2 to @p address on the pty @p path for @p duration at 115200 8N1.

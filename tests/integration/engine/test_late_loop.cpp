@@ -51,7 +51,8 @@ lines:
     REQUIRE(counters.requests == requests_before + 1);
     asio::post(h.io(), [&] {
         // A slow handler on the shared loop: longer than response_timeout (50 ms); the
-        // simulator answers within 3 ms of the request.
+        // simulator answers within 3 ms of the request. The sleep is the thing under
+        // test (a late loop), not orchestration.
         std::this_thread::sleep_for(milliseconds{120});
         excd.request(read_holding(0x0001), [&](const protocol::Response& r) { read_answer = r; });
     });

@@ -36,6 +36,9 @@ GATEWAY = None  # path of the fieldbridge binary, from --gateway
 START_TIMEOUT = 30.0
 STOP_TIMEOUT = 10.0
 IO_TIMEOUT = 5.0
+# mosquitto's default log types, plus each subscription (subscribe() waits for it).
+BROKER_LOG_TYPES = ("log_type error\nlog_type warning\nlog_type notice\nlog_type information\n"
+                    "log_type subscribe\n")
 
 
 def main():
@@ -186,6 +189,11 @@ class Process:
             return None
         return found
 
+    def mark(self):
+        """The index the next line will have (a start for wait_line)."""
+        with self._condition:
+            return len(self.lines)
+
     def signal(self, sig):
         if self.running():
             os.kill(self.proc.pid, sig)
@@ -230,9 +238,6 @@ class Subscriber(Process):
         retained, _, payload = found[1].split(" ", 2)
         return retained == "1", payload
 
-    def mark(self):
-        with self._condition:
-            return len(self.lines)
 
 
 def json_predicate(check):
@@ -328,6 +333,7 @@ class CellTestCase(unittest.TestCase):
         self.sim = None
         self.gateway = None
         self.broker = None
+        self._subscribers = 0
         self.clients = []
 
     def tearDown(self):
@@ -420,7 +426,8 @@ class CellTestCase(unittest.TestCase):
     def start_broker(self):
         conf = self.path("mosquitto.conf")
         with open(conf, "w", encoding="utf-8") as f:
-            f.write("listener %d 127.0.0.1\n%s%s" % (self.mqtt_port, self.broker_listener, self._persistence()))
+            f.write("listener %d 127.0.0.1\n%s%s%s"
+                    % (self.mqtt_port, self.broker_listener, self._persistence(), BROKER_LOG_TYPES))
         self.broker = Process("mosquitto", ["mosquitto", "-c", conf], self.path("mosquitto.log"))
         self.processes.append(self.broker)
         if not wait_port(self.mqtt_port, START_TIMEOUT, self.broker.running):
@@ -449,16 +456,22 @@ class CellTestCase(unittest.TestCase):
         published while the broker was restarting)."""
         command = ["mosquitto_sub", "-h", "127.0.0.1", "-p", str(self.mqtt_port), "-q", "1",
                    "-F", "%r %t %p"] + list(self.mqtt_client_args)
-        if session is not None:
-            command += ["-c", "-i", session]
+        self._subscribers += 1
+        client_id = session if session is not None else "fb-sub-%d" % self._subscribers
+        command += ["-i", client_id] + (["-c"] if session is not None else [])
         for topic in topics:
             command += ["-t", topic]
-        sub = Subscriber("mosquitto_sub", command, self.path("sub-%d.log" % len(self.processes)),
+        broker_mark = self.broker.mark()
+        sub = Subscriber("mosquitto_sub", command, self.path("sub-%d.log" % self._subscribers),
                          stdout_lines=True)
         self.processes.append(sub)
-        # mosquitto_sub prints nothing when subscribed: give it a moment, bounded, by
-        # waiting for the broker to count it (a retained message would also show it).
-        time.sleep(0.3)
+        # mosquitto_sub prints nothing when subscribed; the broker logs each topic of a
+        # SUBSCRIBE as it adds it ("<client id> <qos> <topic>", log_type subscribe):
+        # the last topic's line means the subscription is in place.
+        suffix = " %s 1 %s" % (client_id, topics[-1])
+        if self.broker.wait_line(lambda line: line.endswith(suffix), START_TIMEOUT, broker_mark) is None:
+            self.fail("mosquitto did not log the subscription of %s to %s:\n%s"
+                      % (client_id, topics[-1], self.broker.text()))
         return sub
 
     def publish(self, topic, payload, retain=False):

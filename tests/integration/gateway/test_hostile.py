@@ -237,6 +237,7 @@ class R6Upstream(gatewaylib.CellTestCase):
                 other.sendall(mbap(sent, R6, read_pdu(0x0082, 1)))
                 self.assertEqual(read_frame(other), (sent, R6, bytes.fromhex("03 02 00 02")))
                 worst_other = max(worst_other, time.monotonic() - asked)
+                # Pacing of the load (one request each 50 ms), not orchestration.
                 time.sleep(max(0.0, started + 0.05 * sent - time.monotonic()))
         finally:
             stop.set()

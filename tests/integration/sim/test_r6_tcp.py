@@ -190,7 +190,11 @@ class R6Tcp(simlib.SimTestCase):
         # Axes: 6, signed 32-bit x1000; axis i sweeps 0..(30+10 i) deg in phase with
         # axis 0, which moves at 10 deg/s; world coordinates equal the axes.
         self.assertEqual(self.regs(client, 0x08DB, 1), [6])
-        time.sleep(0.3)
+        # Until axis 0 has moved 3 deg (0.3 s at 10 deg/s: large against the rounding
+        # of the ratios below); the bounds are computed from the times measured here.
+        moved = simlib.wait_until(
+            lambda: self.decoder(self.regs(client, 0x08DC, 2)).decode_32bit_int() >= 3000, IO_TIMEOUT)
+        self.assertTrue(moved, "axis 0 did not move within %.0f s of the start" % IO_TIMEOUT)
         t0 = time.monotonic()
         d = self.decoder(self.regs(client, 0x08DC, 12))
         t1 = time.monotonic()

@@ -1,6 +1,8 @@
 """Wire-time emulation measured from outside: a reply never arrives before a real
 line could have delivered it (request + 3.5-character silence + turnaround +
-reply), and it arrives close to that moment. Also the gap and collision counters."""
+reply), and it arrives within the same order of magnitude of that moment (how close:
+the Release benchmark fb_bench_line, docs/performance.md). Also the gap and collision
+counters."""
 
 import os
 import statistics
@@ -31,7 +33,7 @@ class WireTime(simlib.SimTestCase):
             self.assertEqual(len(reply), RABS_REPLY_LEN, reply.hex(" "))
             self.assertTrue(simlib.crc_ok(reply))
             latencies.append(t1 - t0)
-            time.sleep(pause)  # the master's silence before the next request
+            time.sleep(pause)  # the master's silence before the next request (under test)
         return latencies
 
     def test_two_register_read_at_115200(self):
@@ -55,9 +57,12 @@ class WireTime(simlib.SimTestCase):
             % (ideal * 1e3, (ideal + median) * 1e3, median * 1e6, p99 * 1e6, late[-1] * 1e6,
                timing["late_us_mean"], timing["late_us_max"], timing["late_over_100us"],
                timing["writes"]))
-        # The client's own overhead (Python, select, two syscalls) is part of what it
-        # sees; a loose bound keeps the test meaningful on a loaded sanitizer build.
-        self.assertLess(median, 0.002)
+        # A functional bound, not a performance figure (this runs in the sanitizer
+        # build, beside other tests): a simulator that timed the line an order of
+        # magnitude slower (9600 for 115200 adds ~20 ms) fails it. The precise figure
+        # (median within +2 ms of the ideal) is the Release benchmark's: fb_bench_line,
+        # "floor reply time".
+        self.assertLess(median, 5 * ideal)
         self.assertEqual(stats["replies"], 200)
         self.assertEqual(timing["writes"], 200)
         self.assertEqual(stats["gap_violations"], 0)  # 1 ms pause > 3.5 characters
@@ -72,6 +77,8 @@ class WireTime(simlib.SimTestCase):
         ideal = line_time(9600, 11, 8, 9, 0.002)
         for latency in self.measure(fd, 5, 0.01):
             self.assertGreaterEqual(latency, ideal)
+            # A functional bound: a reply one more request-and-reply time late (~25 ms)
+            # fails it; the longer characters are what the line above checks.
             self.assertLess(latency, ideal + 0.02)
 
     def test_request_without_silence_is_a_gap_violation(self):
@@ -84,7 +91,7 @@ class WireTime(simlib.SimTestCase):
         stats = self.stats()["buses"]["line-a"]
         self.assertEqual(stats["gap_violations"], 1)
         self.assertLess(stats["min_silence_us"], 29166)
-        time.sleep(0.06)  # now a proper silence
+        time.sleep(0.06)  # now a proper silence (> 29 ms: the silence is under test)
         self.assertEqual(len(transact(fd, READ_RABS, RABS_REPLY_LEN)), RABS_REPLY_LEN)
         self.assertEqual(self.stats()["buses"]["line-a"]["gap_violations"], 1)
         # Two requests in one write: the second has no silence at all.
@@ -102,7 +109,7 @@ class WireTime(simlib.SimTestCase):
         fd = self.open_port("line-a")
         # The reply needs ~22 ms at 9600; the second request arrives long before.
         os.write(fd, READ_RABS)
-        time.sleep(0.002)
+        time.sleep(0.002)  # the second request inside the first's reply time (under test)
         os.write(fd, READ_RABS)
         data = simlib.read_for(fd, 0.3)
         self.assertEqual(len(data), RABS_REPLY_LEN, "the device answers once: " + data.hex(" "))

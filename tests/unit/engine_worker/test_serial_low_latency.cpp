@@ -1,45 +1,19 @@
 // The low-latency request of a serial port (issue 14 item 7): played against drivers
-// that take the flag, have it already, refuse it, drop it, or do not know the call,
-// and through the real port on a pseudo-terminal (which does not know it).
+// that take the flag, have it already, refuse it, drop it, or do not know the call.
+// Through the real port on a pseudo-terminal: tests/integration/engine_worker.
 #include <doctest/doctest.h>
 #include <linux/serial.h>
 
 #include <cerrno>
 #include <vector>
 
-#include "engine/posix_serial_port.hpp"
 #include "engine/serial_low_latency.hpp"
-#include "worker_test_support.hpp"
+#include "fake_serial_driver.hpp"
 
 namespace {
 
 using namespace worker_test;
 using Outcome = fe::LowLatency::Outcome;
-
-/// A driver's serial_struct and what the test wants its ioctls to do.
-struct FakeDriver {
-    int flags = 0;
-    int get_error = 0;
-    int set_error = 0;
-    bool drops_flag = false;
-    std::vector<int> set_flags;  ///< the flags of each TIOCSSERIAL
-
-    fe::SerialIoctls ioctls() {
-        return fe::SerialIoctls{
-            [this](int, serial_struct& out) {
-                if (get_error != 0) return get_error;
-                out.flags = flags;
-                return 0;
-            },
-            [this](int, const serial_struct& in) {
-                set_flags.push_back(in.flags);
-                if (set_error != 0) return set_error;
-                flags = drops_flag ? (in.flags & ~ASYNC_LOW_LATENCY) : in.flags;
-                return 0;
-            },
-        };
-    }
-};
 
 }  // namespace
 
@@ -77,27 +51,4 @@ TEST_CASE("low latency: a driver without the call, one that refuses it, one that
     FakeDriver dropping;
     dropping.drops_flag = true;
     CHECK(fe::request_low_latency(3, dropping.ioctls()).outcome == Outcome::refused);
-}
-
-TEST_CASE("low latency: the port asks at each open through its seam; a pseudo-terminal does not know the call") {
-    TempDir dir;
-    asio::io_context io;
-    const auto link = dir.path() / "ttyLL";
-    PtyDevice device(io, link);
-    fe::SerialSettings settings;
-    settings.path = link.string();
-
-    FakeDriver driver;
-    fe::PosixSerialPort faked(settings, driver.ioctls());
-    CHECK(faked.low_latency().outcome == Outcome::not_requested);
-    faked.open();
-    CHECK(faked.low_latency().outcome == Outcome::enabled);
-    faked.close();
-    faked.open();
-    CHECK(faked.low_latency().outcome == Outcome::already_on);
-    CHECK(driver.set_flags.size() == 1);
-
-    fe::PosixSerialPort real(settings);
-    real.open();
-    CHECK(real.low_latency().outcome == Outcome::not_supported);
 }

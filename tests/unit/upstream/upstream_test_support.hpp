@@ -1,12 +1,12 @@
 #pragma once
-// Test support for the R6 pass-through: a fieldbridge-sim R6 child process, an
-// in-process scriptable Modbus TCP server, bounded loop running, answer capture.
+// Test support for the R6 pass-through: an in-process scriptable Modbus TCP server,
+// bounded loop running, answer capture. The fieldbridge-sim R6 child process:
+// tests/integration/upstream/r6_sim_process.hpp.
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
-#include <sys/types.h>
 #include <vector>
 
 #include <asio/io_context.hpp>
@@ -61,28 +61,6 @@ inline const Bytes mode_read{0x03, 0x08, 0x89, 0x00, 0x01};
 
 [[nodiscard]] Bytes hex(const std::string& text);
 [[nodiscard]] std::string to_hex(const Bytes& bytes);
-
-/// fieldbridge-sim --r6 127.0.0.1:PORT with a control socket, READY awaited (bounded).
-class SimProcess {
-public:
-    explicit SimProcess(std::uint16_t port);
-    ~SimProcess();
-    SimProcess(const SimProcess&) = delete;
-    SimProcess& operator=(const SimProcess&) = delete;
-
-    /// Starts the simulator (again); throws when READY does not come within 20 s.
-    void start();
-    /// SIGTERM, then SIGKILL after 5 s; reaps the child.
-    void kill();
-    /// One control line, one reply line ("ok", "ok ...", "error: ...").
-    [[nodiscard]] std::string control(const std::string& line);
-    [[nodiscard]] std::uint16_t port() const noexcept { return port_; }
-
-private:
-    std::uint16_t port_;
-    std::string dir_;
-    pid_t pid_ = -1;
-};
 
 /// A scriptable upstream on the test's io_context: every complete MBAP request is
 /// handed to `on_request`, which answers through `send` (or not at all).

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "northbound/upstream/upstream_target.hpp"
+#include "r6_sim_process.hpp"
 #include "upstream_test_support.hpp"
 
 using namespace fieldbridge;

@@ -1,7 +1,7 @@
 // The line worker's port life cycle over real pseudo-terminals: the port vanishing
 // and returning (reopen with back-off), a port missing at start, stop() and
 // destruction with work pending.
-#include "worker_test_support.hpp"
+#include "pty_device.hpp"
 
 namespace {
 

@@ -1,7 +1,7 @@
 // The line worker over a real pseudo-terminal: request/reply round trips, priority,
 // deadlines, retries, local echo and garbage, with a scripted device on the pty's
 // master side.
-#include "worker_test_support.hpp"
+#include "pty_device.hpp"
 
 namespace {
 
