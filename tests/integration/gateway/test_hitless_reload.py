@@ -6,6 +6,7 @@ transaction (the simulator measures the idle time between frames on the emulated
 MQTT stays connected through reloads that leave its settings alone."""
 
 import json
+import os
 import re
 import signal
 import threading
@@ -20,6 +21,11 @@ READ_UNIT = 5  # gripper-4 on line-b, max_age 0: every read goes to the line
 # One 2-register XEG read at 115200 8N1 with the simulator's 1 ms turnaround: (8 + 9)
 # bytes x 86.8 us + 2 x 304 us of silence + 1 ms = 3.08 ms (spec section 9).
 TRANSACTION_S = 0.00308
+# The packaged (Release) binaries, as tests/package/test-package.sh runs this test on
+# what it installed: there the spec's bound holds for every reload, "no gap longer
+# than one transaction". The sanitizer build of ctest is several times slower at a
+# line restart and is held to looser bounds (below).
+RELEASE_BUILD = os.environ.get("FIELDBRIDGE_RELEASE_BUILD") == "1"
 
 
 class Reader(threading.Thread):
@@ -162,11 +168,12 @@ class HitlessReload(gl.CellTestCase):
             # can add to a line's idle time. A retune costs well under a transaction; a
             # reload that restarts another line (close, build, open) about one in this
             # sanitizer build, a quarter of that in Release.
-            limit = TRANSACTION_S if n > 1 else 2 * TRANSACTION_S
+            limit = TRANSACTION_S if n > 1 or RELEASE_BUILD else 2 * TRANSACTION_S
             self.assertLessEqual(self.loop_held[n - 1], limit,
                                  "reload %d held the loop %.2f ms" % (n, self.loop_held[n - 1] * 1e3))
             self.assertLessEqual(silence["max_silence_us"],
-                                 base_silence["max_silence_us"] + 3 * TRANSACTION_S * 1e6,
+                                 base_silence["max_silence_us"]
+                                 + (1 if RELEASE_BUILD else 3) * TRANSACTION_S * 1e6,
                                  "reload %d left line-b idle much longer than without a reload" % n)
 
 if __name__ == "__main__":
