@@ -7,10 +7,15 @@
 // manuals' frames and their near misses in every `deploy/run-tests`; the coverage-
 // guided search is tests/fuzz/run-fuzzers (clang, libFuzzer).
 // Usage: <harness> [--mutants N] DIR...   Exit 0, or the harness aborts on a broken
-// invariant after printing it; the input is written to fuzz-replay-failing-input
-// (the working directory) first, for `run-fuzzers`' harness to reproduce.
+// invariant after printing it, or a sanitizer stops it; either way the input is
+// written to fuzz-replay-failing-input (the working directory) as it dies, for
+// `run-fuzzers`' harness to reproduce.
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +26,10 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/common_interface_defs.h>
+#endif
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
@@ -34,12 +43,31 @@ Input read_file(const fs::path& path) {
     return Input(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-/// Runs the harness; the input is on disk while it runs, so an abort leaves it behind.
-void run(const Input& input) {
-    {
-        std::ofstream out("fuzz-replay-failing-input", std::ios::binary | std::ios::trunc);
-        out.write(reinterpret_cast<const char*>(input.data()), static_cast<std::streamsize>(input.size()));
+/// The input being run, for the crash handlers below. A signal handler and the
+/// sanitizers' death callback take no argument, so this is the one file-scope
+/// variable of the program (libFuzzer keeps its current input the same way).
+struct CurrentInput {
+    const std::uint8_t* data = nullptr;
+    std::size_t size = 0;
+};
+CurrentInput current;
+
+/// Writes the input being run to fuzz-replay-failing-input; async-signal-safe (open,
+/// write, close), so it can run in a SIGABRT handler.
+void save_current_input() {
+    const int fd = ::open("fuzz-replay-failing-input", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return;
+    if (::write(fd, current.data, current.size) < 0) {
+        // Nothing more can be done while dying.
     }
+    ::close(fd);
+}
+
+/// A broken FB_FUZZ_CHECK aborts; the input is saved, then abort() goes on.
+extern "C" void save_on_abort(int /*signal*/) { save_current_input(); }
+
+void run(const Input& input) {
+    current = CurrentInput{input.data(), input.size()};
     LLVMFuzzerTestOneInput(input.data(), input.size());
 }
 
@@ -109,6 +137,10 @@ int main(int argc, char** argv) {
         std::cerr << argv[0] << ": no inputs in the given directories; run make_fuzz_seeds first\n";
         return 2;
     }
+    std::signal(SIGABRT, save_on_abort);
+#if defined(__SANITIZE_ADDRESS__)
+    __sanitizer_set_death_callback(save_current_input);  // an ASan or UBSan report
+#endif
     std::sort(files.begin(), files.end());  // the same order, so the same mutants, every run
     std::mt19937 random(20261125);
     std::size_t runs = 0;
@@ -120,7 +152,7 @@ int main(int argc, char** argv) {
         ++runs;
         for (std::size_t m = 0; m < mutants; ++m, ++runs) run(mutate(seed, random));
     }
-    fs::remove("fuzz-replay-failing-input");
+    fs::remove("fuzz-replay-failing-input");  // from an earlier failing run
     std::cout << argv[0] << ": " << files.size() << " inputs and " << runs - 1 - files.size()
               << " mutants, every invariant held\n";
     return 0;
