@@ -88,9 +88,10 @@ class HitlessReload(gl.CellTestCase):
         if applied is None:
             self.fail("reload not applied:\n%s" % self.gateway.text())
         print(applied[1][applied[1].find("; read and checked") + 2:])
-        held = re.search(r"applied in ([0-9.]+) ms on the loop", applied[1])
+        held = re.search(r"applied in ([0-9.]+) ms on the loop, ([0-9.]+) ms of CPU", applied[1])
         self.assertIsNotNone(held, applied[1])
         self.loop_held.append(float(held.group(1)) / 1e3)
+        self.loop_cpu.append(float(held.group(2)) / 1e3)
         done = time.monotonic()
         self.more_reads(self.readers, 30)  # the line carried on after the reload
         return sent, done, self.silence_window()
@@ -123,6 +124,7 @@ class HitlessReload(gl.CellTestCase):
 
         windows = []
         self.loop_held = []  # seconds each reload's apply held the loop (from its log line)
+        self.loop_cpu = []  # seconds of CPU time the loop thread spent in each apply
         # 1. Another line changes (line-a's response timeout): line-a restarts, line-b not.
         self.rewrite("    response_timeout: 300ms\n    broadcast_unit: 100\n",
                      "    response_timeout: 250ms\n    broadcast_unit: 100\n")
@@ -167,9 +169,16 @@ class HitlessReload(gl.CellTestCase):
             # The loop drives every line: what a reload's apply holds it for is the most it
             # can add to a line's idle time. A retune costs well under a transaction; a
             # reload that restarts another line (close, build, open) about one in this
-            # sanitizer build, a quarter of that in Release.
+            # sanitizer build, a quarter of that in Release. That cost is the loop thread's
+            # CPU time; the wall time adds whatever else the OS ran on that core meanwhile
+            # (the simulator, three Python clients, the sanitizer's threads: CI once saw a
+            # restart whose components took 4.9 ms hold the loop 8.8 ms). So the CPU time
+            # is held to the aim and the wall time to a stall bound.
             limit = TRANSACTION_S if n > 1 or RELEASE_BUILD else 2 * TRANSACTION_S
-            self.assertLessEqual(self.loop_held[n - 1], limit,
+            self.assertLessEqual(self.loop_cpu[n - 1], limit,
+                                 "reload %d cost the loop %.2f ms of CPU" % (n, self.loop_cpu[n - 1] * 1e3))
+            stall = (2 if RELEASE_BUILD else 5) * TRANSACTION_S
+            self.assertLessEqual(self.loop_held[n - 1], stall,
                                  "reload %d held the loop %.2f ms" % (n, self.loop_held[n - 1] * 1e3))
             self.assertLessEqual(silence["max_silence_us"],
                                  base_silence["max_silence_us"]

@@ -115,9 +115,11 @@ TEST_CASE("a valid reload: RELOADING=1, components get the new configuration, RE
     CHECK(h.events == std::vector<std::string>{"start lines", "start modbus-tcp", "apply lines", "apply modbus-tcp",
                                                "stop modbus-tcp", "stop lines"});
     CHECK(h.logged("<6>configuration reloaded from gw.yaml (3 lines, 3 devices, MQTT disabled); read and checked in "));
-    // What each component held the loop for, in the order they applied.
+    // What the apply held the loop for, wall and CPU time, then each component in the
+    // order they applied.
     const auto text = h.log_text.str();
-    const auto lines_at = text.find("on the loop (lines ");
+    CHECK(text.find(" ms on the loop, ") != std::string::npos);
+    const auto lines_at = text.find(" ms of CPU (lines ");
     REQUIRE(lines_at != std::string::npos);
     CHECK(text.find(" ms, modbus-tcp ", lines_at) != std::string::npos);
 }
