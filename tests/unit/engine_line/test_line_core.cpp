@@ -177,6 +177,15 @@ const Bytes read_request = fp::encode_rtu(
 
 Bytes reply_1() { return read_reply(1, {7, 8}); }
 
+/// Submits a read of device 0 (address 1) and lets it go out.
+void send_read(FakeLine& line, const std::string& tag, Priority priority = Priority::poll, bool retry = true) {
+    Transaction t = read_tx(0, 1, priority);
+    t.retry_allowed = retry;
+    line.submit(std::move(t), tag);
+    line.advance(1ms);
+    REQUIRE(line.take_written() == read_request);
+}
+
 TEST_CASE("line core: a read goes out after the silence and completes with the reply") {
     FakeLine line;
     line.start();
@@ -270,11 +279,7 @@ TEST_CASE("line core: the port fails with work in flight; it all completes line_
 TEST_CASE("line core: stop completes everything cancelled exactly once; later submissions too") {
     FakeLine line;
     line.start();
-    Transaction written = read_tx(0, 1, Priority::poll);
-    written.retry_allowed = false;
-    line.submit(std::move(written), "in-flight");
-    line.advance(1ms);
-    REQUIRE(line.take_written() == read_request);
+    send_read(line, "in-flight", Priority::poll, false);
     line.submit(read_tx(1, 2, Priority::poll), "queued");
     line.advance(0ms);
     line.submit(write_tx(1, 2, 0x0601, 1), "inbox");  // not taken by a drive yet
@@ -343,9 +348,7 @@ TEST_CASE("line core: a completion may stop the line") {
 TEST_CASE("line core: a command whose deadline passes behind the one in flight never reaches the wire") {
     FakeLine line;
     line.start();
-    line.submit(read_tx(0, 1, Priority::poll), "slow");
-    line.advance(1ms);
-    REQUIRE(line.take_written() == read_request);
+    send_read(line, "slow");
     Transaction command = write_tx(1, 2, 0x0601, 1);
     command.deadline = line.now + 10ms;
     line.submit(std::move(command), "command");
@@ -386,11 +389,7 @@ TEST_CASE("line core: a reply already in the driver's buffer is read before the 
     // port's readiness handler (a loop held up): it must read first.
     FakeLine line;
     line.start();
-    Transaction poll = read_tx(0, 1, Priority::poll);
-    poll.retry_allowed = false;
-    line.submit(std::move(poll), "poll");
-    line.advance(1ms);
-    REQUIRE(line.take_written() == read_request);
+    send_read(line, "poll", Priority::poll, false);
     line.now += 1s;  // the loop was held up: no timer ran
     line.input.push_back(reply_1());
     line.submit(read_tx(1, 2, Priority::poll), "other");
@@ -403,9 +402,7 @@ TEST_CASE("line core: a reply already in the driver's buffer is read before the 
 TEST_CASE("line core: after a readiness report or a timer the write needs no read; a posted drive reads first") {
     FakeLine line;
     line.start();
-    line.submit(read_tx(0, 1, Priority::poll), "first");
-    line.advance(1ms);
-    REQUIRE(line.take_written() == read_request);
+    send_read(line, "first");
     unsigned reads = line.reads;
 
     // The reply: one read for the readiness report; the next request waits for the
@@ -433,9 +430,7 @@ TEST_CASE("line core: after a readiness report or a timer the write needs no rea
 TEST_CASE("line core: the port is read until the buffer is not full") {
     FakeLine line;
     line.start();
-    line.submit(read_tx(0, 1, Priority::poll), "poll");
-    line.advance(1ms);
-    REQUIRE(line.take_written() == read_request);
+    send_read(line, "poll");
     const Bytes reply = reply_1();
     line.input.push_back(Bytes(reply.begin(), reply.begin() + 4));
     line.input.push_back(Bytes(reply.begin() + 4, reply.end()));
@@ -455,12 +450,8 @@ TEST_CASE("line core: reply timeouts share the lazy timer; it is not re-set per 
         line.arrive(reply_1());
     }
     CHECK(line.lazy_sets == 1);  // the first reply wait; later ones find it due earlier
-    Transaction lost = read_tx(0, 1, Priority::on_demand);
-    lost.retry_allowed = false;
-    line.submit(std::move(lost), "lost");
-    line.advance(1ms);
+    send_read(line, "lost", Priority::on_demand, false);
     const TimePoint written_at = line.last_write_at;
-    REQUIRE(line.take_written() == read_request);
     line.advance(1s);
     REQUIRE(line.recorder.calls("lost") == 1);
     CHECK(line.recorder.status("lost") == OutcomeStatus::timeout);
