@@ -63,7 +63,9 @@ public:
     LineWorker(const LineWorker&) = delete;
     LineWorker& operator=(const LineWorker&) = delete;
 
-    /// Devices: added before start(), updated between events.
+    /// Devices: added before start(), updated between events. Remove them with
+    /// remove_device() below: the scheduler only collects completions, the worker
+    /// delivers them.
     [[nodiscard]] LineScheduler& scheduler() noexcept;
     [[nodiscard]] const LineScheduler& scheduler() const noexcept;
     void set_state_callback(LineStateCallback callback);
