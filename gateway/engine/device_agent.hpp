@@ -103,7 +103,7 @@ public:
     /// line), and a motion command makes the motion status stale as a unicast one does.
     void broadcast_written(const protocol::Request& request);
 
-    /// From the line's health callback (LineScheduler) or line state (down = offline).
+    /// From the line's health callback (LineWorker) or line state (down = offline).
     void on_health(bool online, TimePoint now);
     void set_notice_callback(NoticeCallback callback);
 

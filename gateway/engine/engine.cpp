@@ -134,7 +134,7 @@ void Engine::wire_health(LineEntry& entry) {
     // of the line offline, and its coming back makes them stale until read.
     std::map<DeviceIndex, DeviceAgent*> by_index;
     for (const auto& agent : entry.agents) by_index[agent->config().index] = agent.get();
-    entry.worker->scheduler().set_health_callback([by_index](DeviceIndex device, bool online, TimePoint now) {
+    entry.worker->set_health_callback([by_index](DeviceIndex device, bool online, TimePoint now) {
         if (const auto it = by_index.find(device); it != by_index.end()) it->second->on_health(online, now);
     });
     entry.worker->set_state_callback([by_index](bool up, TimePoint now) {
@@ -169,7 +169,7 @@ void Engine::update_line(LineEntry& entry, const config::LineConfig& line, Reloa
     auto& scheduler = entry.worker->scheduler();
     // Agents retired by the previous reload have had their time: their requests went
     // out long ago (a reload is an operator's act, not a burst).
-    for (auto& agent : entry.retired) scheduler.remove_device(agent->config().index, OutcomeStatus::cancelled, now);
+    for (auto& agent : entry.retired) entry.worker->remove_device(agent->config().index, OutcomeStatus::cancelled);
     entry.retired.clear();
 
     std::vector<std::unique_ptr<DeviceAgent>> old_agents = std::move(entry.agents);

@@ -2,7 +2,8 @@
 /// @file line_master.hpp
 /// The sans-I/O master of one half-duplex serial line: timing and framing of the ONE
 /// transaction in flight (product spec section 3, rules 1 and 11). It never touches a
-/// port or a clock; the line worker drives it with time points and bytes:
+/// port or a clock; the line core (engine/line_core.hpp) drives it with time points
+/// and bytes:
 ///
 ///     master.start(std::move(transaction), now);
 ///     loop:
@@ -12,7 +13,7 @@
 ///         Finished{tx, outcome} -> scheduler.finished(std::move(tx), outcome, now)
 ///         Idle         -> pick the next transaction
 ///
-/// The worker reads the port in every state (stray bytes count as wire activity and
+/// The core has the port read in every state (stray bytes count as wire activity and
 /// push the next request's silence out).
 ///
 /// States (one transition function resets the deadlines and logs at debug level):

@@ -1,7 +1,6 @@
 #include "engine/line_scheduler.hpp"
 
 #include <algorithm>
-#include <exception>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -99,10 +98,8 @@ void LineScheduler::update_device(DeviceIndex device, DeviceLimits limits) {
 void LineScheduler::remove_device(DeviceIndex device, OutcomeStatus status, TimePoint now) {
     const auto it = devices_.find(device);
     if (it == devices_.end()) return;
-    Completions done;
-    for (Entry& entry : it->second.queue) reject(std::move(entry.transaction), status, now, done);
+    for (Entry& entry : it->second.queue) reject(std::move(entry.transaction), status, now);
     devices_.erase(it);
-    complete(done);
 }
 
 LineScheduler::Device* LineScheduler::find(DeviceIndex device) noexcept {
@@ -162,34 +159,51 @@ LineScheduler::Rank LineScheduler::rank(const Device& device, const Entry& entry
     return r;
 }
 
-void LineScheduler::reject(Transaction transaction, OutcomeStatus status, TimePoint now,
-                           Completions& done) const {
+namespace {
+
+Outcome outcome_of(const Transaction& transaction, OutcomeStatus status, TimePoint now) {
     Outcome outcome;
     outcome.status = status;
     outcome.finished = now;
     outcome.attempts = transaction.attempts;
-    done.push_back(Completion{std::move(transaction), std::move(outcome)});
+    return outcome;
 }
 
-void LineScheduler::complete(Completions& done) {
-    for (Completion& completion : done) {
-        Transaction& t = completion.transaction;
-        if (Device* device = find(t.device)) {
-            ++device->stats.by_class[class_index(t.priority)]
-                  .outcomes[static_cast<std::size_t>(completion.outcome.status)];
-        }
-        if (!t.on_done) continue;
-        try {
-            t.on_done(completion.outcome);
-        } catch (const std::exception& error) {
-            log_(LogLevel::error, describe(t.device) + " #" + std::to_string(t.id) +
-                                      ": completion handler failed: " + error.what());
-        } catch (...) {
-            log_(LogLevel::error, describe(t.device) + " #" + std::to_string(t.id) +
-                                      ": completion handler failed with a non-standard exception");
-        }
+}  // namespace
+
+void LineScheduler::reject(Transaction transaction, OutcomeStatus status, TimePoint now) {
+    const Outcome outcome = outcome_of(transaction, status, now);
+    complete(std::move(transaction), outcome);
+}
+
+void LineScheduler::refuse(Transaction transaction, OutcomeStatus status, TimePoint now) {
+    Outcome outcome = outcome_of(transaction, status, now);
+    completions_.push_back(LineCompletion{std::move(transaction), std::move(outcome)});
+}
+
+void LineScheduler::complete(Transaction transaction, const Outcome& outcome) {
+    if (Device* device = find(transaction.device)) {
+        ++device->stats.by_class[class_index(transaction.priority)].outcomes[static_cast<std::size_t>(outcome.status)];
     }
-    done.clear();
+    completions_.push_back(LineCompletion{std::move(transaction), outcome});
+}
+
+void LineScheduler::take_completions(std::vector<LineCompletion>& into) {
+    if (into.empty()) {
+        into.swap(completions_);
+        return;
+    }
+    for (LineCompletion& completion : completions_) into.push_back(std::move(completion));
+    completions_.clear();
+}
+
+void LineScheduler::take_health_changes(std::vector<HealthChange>& into) {
+    if (into.empty()) {
+        into.swap(health_);
+        return;
+    }
+    into.insert(into.end(), health_.begin(), health_.end());
+    health_.clear();
 }
 
 void LineScheduler::enqueue(Device& device, Transaction transaction, TimePoint now, bool front) {
@@ -199,12 +213,10 @@ void LineScheduler::enqueue(Device& device, Transaction transaction, TimePoint n
 }
 
 void LineScheduler::submit(Transaction transaction, TimePoint now) {
-    Completions done;
     transaction.id = ++next_id_;
     transaction.enqueued = now;
     if (!line_up_) {
-        reject(std::move(transaction), OutcomeStatus::line_down, now, done);
-        complete(done);
+        reject(std::move(transaction), OutcomeStatus::line_down, now);
         return;
     }
     Device* device = find(transaction.device);
@@ -217,28 +229,27 @@ void LineScheduler::submit(Transaction transaction, TimePoint now) {
     if (device == nullptr) {
         log_(LogLevel::error, describe(transaction.device) +
                                   ": request for a device this line does not have; not sent");
-        reject(std::move(transaction), OutcomeStatus::invalid_request, now, done);
+        reject(std::move(transaction), OutcomeStatus::invalid_request, now);
     } else if (transaction.deadline && now >= *transaction.deadline) {
-        reject(std::move(transaction), OutcomeStatus::expired, now, done);
+        reject(std::move(transaction), OutcomeStatus::expired, now);
     } else if (!device->online && !device->queue.empty()) {
-        reject(std::move(transaction), OutcomeStatus::device_offline, now, done);
+        reject(std::move(transaction), OutcomeStatus::device_offline, now);
     } else if (device->queue.size() >= device->limits.queue_limit) {
-        reject(std::move(transaction), OutcomeStatus::queue_full, now, done);
+        reject(std::move(transaction), OutcomeStatus::queue_full, now);
     } else {
         ++device->stats.by_class[class_index(transaction.priority)].submitted;
         enqueue(*device, std::move(transaction), now, false);
     }
-    complete(done);
 }
 
-void LineScheduler::sweep_expired(TimePoint now, Completions& done) {
+void LineScheduler::sweep_expired(TimePoint now) {
     for (auto& [index, device] : devices_) {
         auto& queue = device.queue;
         for (std::size_t i = 0; i < queue.size();) {
             const auto& deadline = queue[i].transaction.deadline;
             if (deadline && now >= *deadline) {
                 --device.stats.by_class[class_index(queue[i].transaction.priority)].depth;
-                reject(std::move(queue[i].transaction), OutcomeStatus::expired, now, done);
+                reject(std::move(queue[i].transaction), OutcomeStatus::expired, now);
                 queue.erase(queue.begin() + static_cast<std::ptrdiff_t>(i));
             } else {
                 ++i;
@@ -247,15 +258,10 @@ void LineScheduler::sweep_expired(TimePoint now, Completions& done) {
     }
 }
 
-void LineScheduler::expire(TimePoint now) {
-    Completions done;
-    sweep_expired(now, done);
-    complete(done);
-}
+void LineScheduler::expire(TimePoint now) { sweep_expired(now); }
 
 std::optional<Transaction> LineScheduler::next(TimePoint now) {
-    Completions done;
-    sweep_expired(now, done);
+    sweep_expired(now);
 
     struct Choice {
         Device* device = nullptr;
@@ -300,11 +306,10 @@ std::optional<Transaction> LineScheduler::next(TimePoint now) {
         stats.wait.record(now - entry.queued_at);
         picked = std::move(entry.transaction);
     }
-    complete(done);
     return picked;
 }
 
-void LineScheduler::take_offline(DeviceIndex index, Device& device, TimePoint now, Completions& done) {
+void LineScheduler::take_offline(DeviceIndex index, Device& device, TimePoint now) {
     device.online = false;
     device.backoff = device.limits.backoff_initial;
     device.probe_due = now + device.backoff;
@@ -318,7 +323,7 @@ void LineScheduler::take_offline(DeviceIndex index, Device& device, TimePoint no
         for (std::size_t i = 0; i < device.queue.size(); ++i) {
             if (i == keep) continue;
             --device.stats.by_class[class_index(device.queue[i].transaction.priority)].depth;
-            reject(std::move(device.queue[i].transaction), OutcomeStatus::device_offline, now, done);
+            reject(std::move(device.queue[i].transaction), OutcomeStatus::device_offline, now);
         }
         Entry kept = std::move(device.queue[keep]);
         device.queue.clear();
@@ -330,7 +335,7 @@ void LineScheduler::take_offline(DeviceIndex index, Device& device, TimePoint no
                                 milliseconds_text(device.backoff) + " to " +
                                 milliseconds_text(device.limits.backoff_max) +
                                 "; check its power, wiring, address and baud rate");
-    if (on_health_) on_health_(index, false, now);
+    health_.push_back(HealthChange{index, false, now});
 }
 
 void LineScheduler::bring_online(DeviceIndex index, Device& device, TimePoint now) {
@@ -338,15 +343,13 @@ void LineScheduler::bring_online(DeviceIndex index, Device& device, TimePoint no
     device.backoff = device.limits.backoff_initial;
     ++device.stats.came_online;
     log_(LogLevel::info, describe(index) + ": answering again, back online");
-    if (on_health_) on_health_(index, true, now);
+    health_.push_back(HealthChange{index, true, now});
 }
 
 void LineScheduler::finished(Transaction transaction, const Outcome& outcome, TimePoint now) {
-    Completions done;
     Device* device = find(transaction.device);
     if (device == nullptr || is_broadcast(transaction)) {
-        done.push_back(Completion{std::move(transaction), outcome});
-        complete(done);
+        complete(std::move(transaction), outcome);
         return;
     }
     const DeviceIndex index = transaction.device;
@@ -365,14 +368,13 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
             device->backoff = std::min(device->backoff * 2, device->limits.backoff_max);
             device->probe_due = now + device->backoff;
         } else if (device->consecutive_timeouts >= device->limits.offline_after) {
-            take_offline(index, *device, now, done);
+            take_offline(index, *device, now);
         }
         if (device->online && may_retry(transaction) &&
             transaction.attempts <= device->limits.read_retries) {
             auto& stats = device->stats.by_class[class_index(transaction.priority)];
             ++stats.retries;
             enqueue(*device, std::move(transaction), now, true);
-            complete(done);
             return;
         }
         if (may_write(transaction)) {
@@ -381,8 +383,7 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
                                         "acted); reported as failed");
         }
     }
-    done.push_back(Completion{std::move(transaction), outcome});
-    complete(done);
+    complete(std::move(transaction), outcome);
 }
 
 std::optional<TimePoint> LineScheduler::next_wakeup(TimePoint now) const {
@@ -403,15 +404,13 @@ std::optional<TimePoint> LineScheduler::next_wakeup(TimePoint now) const {
 }
 
 void LineScheduler::cancel_all(OutcomeStatus status, TimePoint now) {
-    Completions done;
     for (auto& [index, device] : devices_) {
         for (Entry& entry : device.queue) {
             --device.stats.by_class[class_index(entry.transaction.priority)].depth;
-            reject(std::move(entry.transaction), status, now, done);
+            reject(std::move(entry.transaction), status, now);
         }
         device.queue.clear();
     }
-    complete(done);
 }
 
 void LineScheduler::set_line_up(bool up, TimePoint now) {

@@ -42,9 +42,10 @@
 /// never retried, whatever the flag says. A write that timed out completes `timeout`
 /// and is logged as a warning (the device may have acted).
 ///
-/// Every submitted transaction's on_done is called exactly once, on the calling
-/// thread, after the scheduler's state is updated (so on_done may submit again). An
-/// exception from on_done is caught and logged; the other completions still run.
+/// Every submitted transaction completes exactly once. Completions and device health
+/// changes are collected, never called from inside a method (the same design as
+/// northbound/upstream/upstream_scheduler.hpp): the line core hands them to its shell,
+/// which calls them after the transition, so a handler may submit or stop at will.
 
 #include <array>
 #include <cstddef>
@@ -116,6 +117,19 @@ struct DeviceStats {
 /// Online/offline transitions, for MQTT state and alarms.
 using HealthCallback = std::function<void(DeviceIndex device, bool online, TimePoint now)>;
 
+/// A transaction and its outcome, to hand to its on_done.
+struct LineCompletion {
+    Transaction transaction;
+    Outcome outcome;
+};
+
+/// A device went offline or came back online at @p at.
+struct HealthChange {
+    DeviceIndex device = 0;
+    bool online = true;
+    TimePoint at{};
+};
+
 class LineScheduler {
 public:
     explicit LineScheduler(SchedulerConfig config, LogSink log = {});
@@ -132,7 +146,6 @@ public:
     /// Reload: forgets @p device. Its queued transactions complete with @p status; one
     /// in flight still completes through finished(). Unknown devices are ignored.
     void remove_device(DeviceIndex device, OutcomeStatus status, TimePoint now);
-    void set_health_callback(HealthCallback callback) { on_health_ = std::move(callback); }
 
     /// Queues @p transaction (sets id and enqueued), or completes it at once:
     /// `line_down` while the line is down, `invalid_request` for an unknown device,
@@ -145,8 +158,12 @@ public:
     [[nodiscard]] std::optional<Transaction> next(TimePoint now);
 
     /// The line master finished @p transaction: applies the retry and offline policy,
-    /// then calls on_done exactly once (unless it is re-queued for a retry).
+    /// then completes it (unless it is re-queued for a retry).
     void finished(Transaction transaction, const Outcome& outcome, TimePoint now);
+
+    /// Completes @p transaction with @p status without queueing it (the line's inbox
+    /// at shutdown). Not counted in the device's statistics.
+    void refuse(Transaction transaction, OutcomeStatus status, TimePoint now);
 
     /// When next() may have something to hand out while nothing is submitted: now if
     /// something is eligible, else the earliest probe time or deadline; nullopt when
@@ -163,6 +180,16 @@ public:
     /// until it is up again.
     void set_line_up(bool up, TimePoint now);
     [[nodiscard]] bool line_up() const noexcept { return line_up_; }
+
+    /// Completions decided since the last take, in order, appended to @p into (swapped
+    /// when @p into is empty: the two buffers keep their capacity, no allocation).
+    void take_completions(std::vector<LineCompletion>& into);
+    /// Health changes since the last take, in order; deliver them before the
+    /// completions taken with them (a device's offline notice comes before the
+    /// outcomes it caused).
+    void take_health_changes(std::vector<HealthChange>& into);
+    [[nodiscard]] bool has_completions() const noexcept { return !completions_.empty(); }
+    [[nodiscard]] bool has_health_changes() const noexcept { return !health_.empty(); }
 
     [[nodiscard]] bool has_device(DeviceIndex device) const noexcept;
     /// False for an unknown device.
@@ -193,11 +220,6 @@ private:
         DeviceStats stats;
     };
     struct Rank;
-    struct Completion {
-        Transaction transaction;
-        Outcome outcome;
-    };
-    using Completions = std::vector<Completion>;
 
     void check_limits(DeviceIndex device, const DeviceLimits& limits) const;
     [[nodiscard]] Device* find(DeviceIndex device) noexcept;
@@ -205,18 +227,21 @@ private:
     [[nodiscard]] bool eligible(const Device& device, TimePoint now) const noexcept;
     [[nodiscard]] Rank rank(const Device& device, const Entry& entry, TimePoint now) const noexcept;
     [[nodiscard]] Duration poll_age(const Transaction& transaction) const noexcept;
-    void sweep_expired(TimePoint now, Completions& done);
-    void take_offline(DeviceIndex index, Device& device, TimePoint now, Completions& done);
+    void sweep_expired(TimePoint now);
+    void take_offline(DeviceIndex index, Device& device, TimePoint now);
     void bring_online(DeviceIndex index, Device& device, TimePoint now);
     void enqueue(Device& device, Transaction transaction, TimePoint now, bool front);
-    void reject(Transaction transaction, OutcomeStatus status, TimePoint now, Completions& done) const;
-    void complete(Completions& done);
+    /// Completes @p transaction with @p status (never sent).
+    void reject(Transaction transaction, OutcomeStatus status, TimePoint now);
+    /// Counts the outcome and collects the completion.
+    void complete(Transaction transaction, const Outcome& outcome);
     [[nodiscard]] std::string describe(DeviceIndex device) const;
 
     SchedulerConfig config_;
     LogSink log_;
-    HealthCallback on_health_;
     std::map<DeviceIndex, Device> devices_;
+    std::vector<LineCompletion> completions_;  ///< collected, for take_completions()
+    std::vector<HealthChange> health_;         ///< collected, for take_health_changes()
     bool line_up_ = true;
     std::uint64_t next_id_ = 0;
     std::uint64_t next_sequence_ = 0;

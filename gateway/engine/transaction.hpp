@@ -2,7 +2,8 @@
 /// @file transaction.hpp
 /// One request on a half-duplex line and its outcome. The vocabulary shared by the
 /// scheduler (which transaction goes next), the line master (timing and framing of
-/// the one in flight), the line worker (I/O) and the device agents (who asked).
+/// the one in flight), the line core and its shells (I/O) and the device agents (who
+/// asked).
 
 #include <chrono>
 #include <cstddef>

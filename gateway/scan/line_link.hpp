@@ -1,15 +1,18 @@
 #pragma once
 /// @file line_link.hpp
-/// One request at a time on a serial port, synchronously: the scan's own small
-/// driver of the sans-I/O LineMaster (engine/line_master.hpp), so a probe obeys the
-/// same line timing as the gateway (t3.5 silence, turnaround, local echo, replies
-/// framed by their predicted length, timers as backstops). It waits with ppoll() on
-/// the port's descriptor and reads the monotonic clock; there is no event loop
-/// because a scan is a one-shot tool with the port to itself.
+/// One request at a time on a serial port, synchronously: the scan's shell around the
+/// engine's sans-I/O line core (engine/line_core.hpp), so a probe obeys the same line
+/// timing and drive loop as the gateway (t3.5 silence, turnaround, local echo,
+/// replies framed by their predicted length, timers as backstops). It waits with
+/// ppoll() on the port's descriptor and reads the monotonic clock; there is no event
+/// loop because a scan is a one-shot tool with the port to itself.
 
+#include <array>
 #include <cstdint>
+#include <optional>
 
-#include "engine/line_master.hpp"
+#include "engine/line_core.hpp"
+#include "engine/line_delivery.hpp"
 #include "engine/serial_port.hpp"
 #include "engine/transaction.hpp"
 #include "protocol/bytes.hpp"
@@ -34,17 +37,29 @@ public:
     /// The bytes count as wire activity for the next request's silence.
     [[nodiscard]] protocol::Bytes listen(engine::Duration quiet, engine::Duration limit);
 
-    [[nodiscard]] const engine::LineMaster& master() const noexcept { return master_; }
+    [[nodiscard]] const engine::LineMaster& master() const noexcept { return core_.master(); }
 
 private:
-    /// Waits until the port is readable or @p until; hands what arrived to the
-    /// master (and appends it to @p sink when given).
-    void wait_and_read(engine::TimePoint until, protocol::Bytes* sink);
-    void write_all(protocol::ByteView bytes);
+    /// Carries out @p event's steps until the core asks nothing; bytes read go to the
+    /// core and to sink_ when set.
+    void feed(engine::LineEvent&& event);
+    void apply(const engine::LineStep& step);
+    [[nodiscard]] engine::LineEvent read();
+    [[nodiscard]] engine::LineEvent write(protocol::ByteView bytes);
+    /// Feeds the next event: a Drive the core asked for, Writable once the driver
+    /// takes bytes again, else Readable or the earlier wake timer's TimerFired;
+    /// nothing to wait for is a logic error.
+    void wait_for_event();
 
     engine::SerialPort& port_;
-    engine::LineMaster master_;
-    std::uint64_t next_id_ = 1;
+    engine::LineCore core_;
+    engine::LineDelivery delivery_;
+    std::optional<engine::TimePoint> exact_at_;
+    std::optional<engine::TimePoint> lazy_at_;
+    bool watch_writable_ = false;
+    bool pending_drive_ = false;  ///< the core asked for a Drive: the next thing to feed
+    protocol::Bytes* sink_ = nullptr;
+    std::array<std::uint8_t, 256> buffer_{};
 };
 
 }  // namespace fieldbridge::scan

@@ -6,11 +6,14 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "engine/line_core.hpp"
+#include "engine/line_delivery.hpp"
 #include "engine/line_master.hpp"
 #include "engine/line_scheduler.hpp"
 #include "engine/transaction.hpp"
@@ -129,6 +132,73 @@ inline Bytes concat(std::initializer_list<Bytes> parts) {
     for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
     return out;
 }
+
+// ---- the scheduler, delivered ----------------------------------------------------
+
+/// A LineScheduler whose collected completions and health changes are delivered
+/// after every call, as the line core's shell delivers them after every transition
+/// (LineDelivery: health changes first, a handler may submit).
+class Scheduler {
+public:
+    explicit Scheduler(fe::SchedulerConfig config = {"A"}, fe::LogSink log = {})
+        : delivery_(config.line_name, log), scheduler_(std::move(config), std::move(log)) {}
+
+    void add_device(fe::DeviceIndex device, fe::DeviceLimits limits, std::string name = {}) {
+        scheduler_.add_device(device, limits, std::move(name));
+    }
+    void update_device(fe::DeviceIndex device, fe::DeviceLimits limits) { scheduler_.update_device(device, limits); }
+    void set_health_callback(fe::HealthCallback callback) { delivery_.set_health_callback(std::move(callback)); }
+
+    void remove_device(fe::DeviceIndex device, fe::OutcomeStatus status, TimePoint now) {
+        scheduler_.remove_device(device, status, now);
+        deliver();
+    }
+    void submit(Transaction transaction, TimePoint now) {
+        scheduler_.submit(std::move(transaction), now);
+        deliver();
+    }
+    std::optional<Transaction> next(TimePoint now) {
+        std::optional<Transaction> picked = scheduler_.next(now);
+        deliver();
+        return picked;
+    }
+    void finished(Transaction transaction, const fe::Outcome& outcome, TimePoint now) {
+        scheduler_.finished(std::move(transaction), outcome, now);
+        deliver();
+    }
+    void expire(TimePoint now) {
+        scheduler_.expire(now);
+        deliver();
+    }
+    void cancel_all(fe::OutcomeStatus status, TimePoint now) {
+        scheduler_.cancel_all(status, now);
+        deliver();
+    }
+    void set_line_up(bool up, TimePoint now) {
+        scheduler_.set_line_up(up, now);
+        deliver();
+    }
+
+    [[nodiscard]] std::optional<TimePoint> next_wakeup(TimePoint now) const { return scheduler_.next_wakeup(now); }
+    [[nodiscard]] bool line_up() const noexcept { return scheduler_.line_up(); }
+    [[nodiscard]] bool has_device(fe::DeviceIndex device) const noexcept { return scheduler_.has_device(device); }
+    [[nodiscard]] bool online(fe::DeviceIndex device) const noexcept { return scheduler_.online(device); }
+    [[nodiscard]] const fe::DeviceStats* stats(fe::DeviceIndex device) const noexcept {
+        return scheduler_.stats(device);
+    }
+    [[nodiscard]] std::size_t queued(fe::DeviceIndex device) const noexcept { return scheduler_.queued(device); }
+    [[nodiscard]] std::size_t queued() const noexcept { return scheduler_.queued(); }
+    [[nodiscard]] std::optional<TimePoint> probe_due(fe::DeviceIndex device) const noexcept {
+        return scheduler_.probe_due(device);
+    }
+    [[nodiscard]] const fe::SchedulerConfig& config() const noexcept { return scheduler_.config(); }
+
+private:
+    void deliver() { delivery_.deliver(scheduler_); }
+
+    fe::LineDelivery delivery_;
+    fe::LineScheduler scheduler_;
+};
 
 // ---- master drivers -------------------------------------------------------------
 

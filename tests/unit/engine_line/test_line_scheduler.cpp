@@ -12,15 +12,15 @@ namespace {
 using namespace line_test;
 using fe::OutcomeStatus;
 
-fe::LineScheduler make_scheduler(std::size_t devices = 3, fe::DeviceLimits limits = {},
-                                 fe::SchedulerConfig config = {"A"}) {
-    fe::LineScheduler scheduler(std::move(config));
+Scheduler make_scheduler(std::size_t devices = 3, fe::DeviceLimits limits = {},
+                         fe::SchedulerConfig config = {"A"}) {
+    Scheduler scheduler(std::move(config));
     for (std::size_t i = 0; i < devices; ++i) scheduler.add_device(static_cast<fe::DeviceIndex>(i), limits);
     return scheduler;
 }
 
 /// Picks the next transaction and completes it as @p status (ok by default).
-std::uint64_t run_next(fe::LineScheduler& s, TimePoint now, OutcomeStatus status = OutcomeStatus::ok,
+std::uint64_t run_next(Scheduler& s, TimePoint now, OutcomeStatus status = OutcomeStatus::ok,
                        unsigned attempts = 1) {
     auto t = s.next(now);
     REQUIRE(t.has_value());
@@ -34,7 +34,7 @@ std::uint64_t run_next(fe::LineScheduler& s, TimePoint now, OutcomeStatus status
     return id;
 }
 
-std::string next_tag(fe::LineScheduler& s, Recorder& r, TimePoint now) {
+std::string next_tag(Scheduler& s, Recorder& r, TimePoint now) {
     const auto before = r.total();
     run_next(s, now);
     REQUIRE(r.total() == before + 1);
@@ -245,7 +245,7 @@ TEST_CASE("scheduler: with read_retries 0 a read is not retried") {
 TEST_CASE("scheduler: a write that timed out is never retried, even if flagged retryable") {
     std::vector<std::string> logs;
     Recorder r;
-    fe::LineScheduler logged({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
+    Scheduler logged({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
                                                     if (level == fe::LogLevel::warning) logs.emplace_back(m);
                                                 },
                                                 fe::LogLevel::info});
@@ -268,7 +268,7 @@ TEST_CASE("scheduler: a write that timed out is never retried, even if flagged r
 TEST_CASE("scheduler: log messages name a device by its config name when it has one") {
     std::vector<std::string> logs;
     Recorder r;
-    fe::LineScheduler logged({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
+    Scheduler logged({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
                                                     if (level == fe::LogLevel::warning) logs.emplace_back(m);
                                                 },
                                                 fe::LogLevel::info});
@@ -455,7 +455,7 @@ TEST_CASE("scheduler: ids are unique and enqueued is set; on_done may submit aga
         CHECK(outcome.status == OutcomeStatus::ok);
         auto next = read_tx(0, 1, Priority::poll);
         next.on_done = [&](const fe::Outcome&) { ++follow_ups; };
-        s.submit(std::move(next), t0 + 5ms);  // re-entrant submit from a completion
+        s.submit(std::move(next), t0 + 5ms);  // a submit from a completion
     };
     s.submit(std::move(first), t0);
     auto picked = s.next(t0 + 1ms);
@@ -475,7 +475,7 @@ TEST_CASE("scheduler: ids are unique and enqueued is set; on_done may submit aga
 
 TEST_CASE("scheduler: a throwing on_done is logged and the other completions still run") {
     std::vector<std::string> errors;
-    fe::LineScheduler s({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
+    Scheduler s({"A"}, fe::LogSink{[&](fe::LogLevel level, std::string_view m) {
                                               if (level == fe::LogLevel::error) errors.emplace_back(m);
                                           },
                                           fe::LogLevel::debug});

@@ -27,7 +27,7 @@ fe::DeviceLimits dead_device_limits() {
 }
 
 struct Fixture {
-    fe::LineScheduler s{fe::SchedulerConfig{"A"}};
+    Scheduler s{fe::SchedulerConfig{"A"}};
     Recorder r;
     Health health;
     int count = 0;
