@@ -33,6 +33,9 @@ public:
     /// A field of /proc/<pid>/smaps_rollup ("Pss:", "Pss_Anon:", "Private_Dirty:"...)
     /// in KiB; 0 when unreadable.
     [[nodiscard]] long memory_kib(const std::string& field) const { return proc_kib("smaps_rollup", field); }
+    /// A field of /proc/<pid>/status ("RssAnon:", "RssFile:"...) in KiB, or a count
+    /// ("Threads:"); 0 when unreadable.
+    [[nodiscard]] long status_field(const std::string& field) const { return proc_kib("status", field); }
     /// SIGTERM, bounded wait, SIGKILL; the exit status or -1 when killed. Idempotent.
     int terminate(std::chrono::milliseconds timeout = std::chrono::seconds{10});
     [[nodiscard]] std::string log_text() const;

@@ -13,9 +13,8 @@
 #include <asio/posix/stream_descriptor.hpp>
 #include <asio/steady_timer.hpp>
 #include <fmt/format.h>
-#include <microhttpd.h>
-
 #include "northbound/metrics/exposition.hpp"
+#include "northbound/metrics/microhttpd_library.hpp"
 #include "northbound/modbus_tcp/listen_socket.hpp"
 
 namespace fieldbridge::northbound::metrics {
@@ -70,24 +69,24 @@ constexpr std::string_view metrics_path = "/metrics";
 }
 
 /// Queues a copy of @p body with status @p status; false when MHD refused it.
-[[nodiscard]] bool respond(MHD_Connection* connection, unsigned status, const std::string& body,
-                           std::string_view type, bool allow_header) {
+[[nodiscard]] bool respond(const MicrohttpdApi& mhd, MHD_Connection* connection, unsigned status,
+                           const std::string& body, std::string_view type, bool allow_header) {
     // MHD_RESPMEM_MUST_COPY: MHD keeps its own copy, so @p body may go at once.
-    MHD_Response* response = MHD_create_response_from_buffer(body.size(), const_cast<char*>(body.data()),
+    MHD_Response* response = mhd.create_response_from_buffer(body.size(), const_cast<char*>(body.data()),
                                                               MHD_RESPMEM_MUST_COPY);
     if (response == nullptr) return false;
-    bool ok = MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, std::string(type).c_str()) == MHD_YES;
-    if (ok && allow_header) ok = MHD_add_response_header(response, MHD_HTTP_HEADER_ALLOW, "GET, HEAD") == MHD_YES;
-    if (ok) ok = MHD_queue_response(connection, status, response) == MHD_YES;
-    MHD_destroy_response(response);
+    bool ok = mhd.add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, std::string(type).c_str()) == MHD_YES;
+    if (ok && allow_header) ok = mhd.add_response_header(response, MHD_HTTP_HEADER_ALLOW, "GET, HEAD") == MHD_YES;
+    if (ok) ok = mhd.queue_response(connection, status, response) == MHD_YES;
+    mhd.destroy_response(response);
     return ok;
 }
 
 }  // namespace
 
 struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
-    Core(asio::io_context& io, config::ListenAddress listen, Render renderer)
-        : address(std::move(listen)), render(std::move(renderer)), ready(io), timer(io) {}
+    Core(asio::io_context& io, config::ListenAddress listen, Render renderer, const MicrohttpdApi& library)
+        : mhd(library), address(std::move(listen)), render(std::move(renderer)), ready(io), timer(io) {}
 
     Core(const Core&) = delete;
     Core& operator=(const Core&) = delete;
@@ -98,23 +97,23 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
             // The descriptor is MHD's: asio must not close it.
             [[maybe_unused]] const int fd = ready.release();
         }
-        if (daemon != nullptr) MHD_stop_daemon(daemon);  // closes the listening socket and every connection
+        if (daemon != nullptr) mhd.stop_daemon(daemon);  // closes the listening socket and every connection
     }
 
     void start(int listen_fd, const HttpEndpointLimits& limits) {
         port = bound_port(listen_fd);
-        daemon = MHD_start_daemon(MHD_USE_EPOLL, 0, nullptr, nullptr, &Core::on_request, this,
-                                  MHD_OPTION_LISTEN_SOCKET, listen_fd,
-                                  MHD_OPTION_CONNECTION_LIMIT, static_cast<unsigned int>(limits.max_connections),
-                                  MHD_OPTION_CONNECTION_TIMEOUT,
-                                  static_cast<unsigned int>(limits.connection_timeout.count()), MHD_OPTION_END);
+        daemon = mhd.start_daemon(MHD_USE_EPOLL, 0, nullptr, nullptr, &Core::on_request, this,
+                                 MHD_OPTION_LISTEN_SOCKET, listen_fd,
+                                 MHD_OPTION_CONNECTION_LIMIT, static_cast<unsigned int>(limits.max_connections),
+                                 MHD_OPTION_CONNECTION_TIMEOUT,
+                                 static_cast<unsigned int>(limits.connection_timeout.count()), MHD_OPTION_END);
         if (daemon == nullptr) {
             ::close(listen_fd);
             throw MetricsHttpError(fmt::format("metrics HTTP: cannot serve on {}: libmicrohttpd did not start (out of "
                                                "memory or descriptors?); check LimitNOFILE and the journal",
                                                address.to_string()));
         }
-        const MHD_DaemonInfo* info = MHD_get_daemon_info(daemon, MHD_DAEMON_INFO_EPOLL_FD);
+        const MHD_DaemonInfo* info = mhd.get_daemon_info(daemon, MHD_DAEMON_INFO_EPOLL_FD);
         if (info == nullptr) {
             throw MetricsHttpError(fmt::format("metrics HTTP: cannot serve on {}: libmicrohttpd has no epoll "
                                                "descriptor (built without epoll support?)",
@@ -139,7 +138,7 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
     /// MHD's own deadline (idle connections); zero when it has work left over.
     void schedule() {
         MHD_UNSIGNED_LONG_LONG timeout_ms = 0;
-        if (MHD_get_timeout(daemon, &timeout_ms) != MHD_YES) {
+        if (mhd.get_timeout(daemon, &timeout_ms) != MHD_YES) {
             timer.cancel();
             return;
         }
@@ -152,7 +151,7 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
     }
 
     void run() {
-        MHD_run(daemon);
+        mhd.run(daemon);
         schedule();
     }
 
@@ -170,22 +169,23 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
     [[nodiscard]] bool answer(MHD_Connection* connection, std::string_view url, std::string_view method) {
         constexpr std::string_view text = "text/plain; charset=utf-8";
         if (url != metrics_path) {
-            return respond(connection, MHD_HTTP_NOT_FOUND, "not found: only /metrics is served here\n", text, false);
+            return respond(mhd, connection, MHD_HTTP_NOT_FOUND, "not found: only /metrics is served here\n", text, false);
         }
         if (method != MHD_HTTP_METHOD_GET && method != MHD_HTTP_METHOD_HEAD) {
-            return respond(connection, MHD_HTTP_METHOD_NOT_ALLOWED, "method not allowed: use GET or HEAD\n", text,
+            return respond(mhd, connection, MHD_HTTP_METHOD_NOT_ALLOWED, "method not allowed: use GET or HEAD\n", text,
                            true);
         }
         std::string body;
         try {
             body = render();
         } catch (const std::exception& error) {
-            return respond(connection, MHD_HTTP_INTERNAL_SERVER_ERROR,
+            return respond(mhd, connection, MHD_HTTP_INTERNAL_SERVER_ERROR,
                            std::string("cannot render the metrics: ") + error.what() + "\n", text, false);
         }
-        return respond(connection, MHD_HTTP_OK, body, content_type, false);
+        return respond(mhd, connection, MHD_HTTP_OK, body, content_type, false);
     }
 
+    const MicrohttpdApi& mhd;
     config::ListenAddress address;
     Render render;
     asio::posix::stream_descriptor ready;
@@ -195,8 +195,11 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
 };
 
 HttpEndpoint::HttpEndpoint(asio::io_context& io, const config::ListenAddress& address, Render render,
-                           HttpEndpointLimits limits)
-    : core_(std::make_shared<Core>(io, address, std::move(render))) {
+                           HttpEndpointLimits limits, const std::string& library)
+    : core_(std::make_shared<Core>(
+          io, address, std::move(render),
+          load_microhttpd(library.empty() ? std::string(microhttpd_soname) : library,
+                          fmt::format("metrics HTTP: cannot serve on {}", address.to_string())))) {
     core_->start(bind_metrics_socket(io, address), limits);
 }
 

@@ -7,6 +7,9 @@
 /// renders on the loop thread (a quick walk over in-memory counters), so it never
 /// races the lines, and the response is copied to MHD at once.
 ///
+/// libmicrohttpd is loaded with dlopen() by the first endpoint (microhttpd_library.hpp),
+/// so a daemon without `metrics_http` maps neither it nor GnuTLS.
+///
 /// Only GET and HEAD on /metrics: 404 for another path, 405 (with `Allow`) for
 /// another method. Connections are bounded in number and idle time.
 // Standard headers before asio's (see daemon/daemon.hpp).
@@ -45,9 +48,11 @@ public:
     using Render = std::function<std::string()>;
 
     /// Binds and listens on @p address (port 0: a free port, see port()) and starts
-    /// serving on @p io. Throws MetricsHttpError when the address cannot be used.
+    /// serving on @p io. @p library: the libmicrohttpd to load (empty: its SONAME; a
+    /// seam for tests). Throws MetricsHttpError when the library cannot be loaded or
+    /// the address cannot be used.
     HttpEndpoint(asio::io_context& io, const config::ListenAddress& address, Render render,
-                 HttpEndpointLimits limits = {});
+                 HttpEndpointLimits limits = {}, const std::string& library = {});
     /// Closes the listener and every connection.
     ~HttpEndpoint();
     HttpEndpoint(const HttpEndpoint&) = delete;

@@ -4,7 +4,8 @@ Modbus TCP traffic shows the line, device, Modbus TCP, upstream, MQTT, reload an
 build families with counters that moved, a transaction-duration histogram whose count
 is the line's transactions, and passes `promtool check metrics` (Debian's
 prometheus package). Also: 404/405, the reload counter, a rebind when the address
-changes on reload, and a clear start-up error when the port is taken."""
+changes on reload, a clear start-up error when the port is taken, and libmicrohttpd
+(with GnuTLS) mapped only once metrics_http is configured."""
 
 import re
 import shutil
@@ -179,7 +180,26 @@ class Metrics(gatewaylib.CellTestCase):
         self.assertIn("set metrics_http.listen to a free port", self.gateway.text())
         self.assertNotIn("ready:", self.gateway.text())
 
+    def test_libmicrohttpd_and_gnutls_are_loaded_only_with_metrics_http(self):
+        # Issue 14 item 6: the library is loaded with dlopen() when the endpoint starts
+        # (docs/dependencies.md), so a gateway without metrics_http maps neither it
+        # nor the GnuTLS it brings; a reload that adds the section loads it.
+        self.start_cell()
+        self.assertEqual(self.mapped_libraries("libmicrohttpd", "libgnutls"), set())
+        self.metrics_port = gatewaylib.free_port()
+        with open(self.config_path, "a", encoding="utf-8") as f:
+            f.write(gatewaylib.METRICS_CONFIG.format(metrics_port=self.metrics_port))
+        self.reload("configuration reloaded")
+        self.assertIn("fieldbridge_build_info", self.scrape())
+        self.assertEqual(self.mapped_libraries("libmicrohttpd", "libgnutls"), {"libmicrohttpd", "libgnutls"})
+
     # -- helpers ---------------------------------------------------------------------
+
+    def mapped_libraries(self, *prefixes):
+        """Which of the file name prefixes the gateway process maps (/proc/<pid>/maps)."""
+        with open("/proc/%d/maps" % self.gateway.pid, encoding="utf-8") as f:
+            names = {line.split()[-1].rsplit("/", 1)[-1] for line in f if "/" in line}
+        return {prefix for prefix in prefixes if any(name.startswith(prefix + ".so") for name in names)}
 
     def reload(self, expected):
         start = len(self.gateway.lines)

@@ -175,6 +175,43 @@ TEST_CASE("a port in use fails with the address, the failed step and what to do"
     }
 }
 
+TEST_CASE("a missing libmicrohttpd fails with the library, dlopen's reason and what to do, before binding") {
+    asio::io_context io;
+    std::uint16_t port = 0;
+    {
+        asio::ip::tcp::acceptor probe(io, {asio::ip::make_address("127.0.0.1"), 0});
+        port = probe.local_endpoint().port();
+    }
+    const config::ListenAddress address{"127.0.0.1", port};
+    try {
+        HttpEndpoint endpoint(io, address, sample_text, {}, "libmicrohttpd-fieldbridge-test-missing.so.12");
+        FAIL("the constructor must throw");
+    } catch (const MetricsHttpError& error) {
+        const std::string message = error.what();
+        CHECK(message.find("cannot serve on " + address.to_string()) != std::string::npos);
+        CHECK(message.find("cannot load the HTTP library libmicrohttpd-fieldbridge-test-missing.so.12") !=
+              std::string::npos);
+        CHECK(message.find("cannot open shared object file") != std::string::npos);  // dlerror()
+        CHECK(message.find("apt install libmicrohttpd12") != std::string::npos);
+        CHECK(message.find("remove the metrics_http section") != std::string::npos);
+    }
+    // The library is loaded before the port is bound: nothing was left listening.
+    asio::ip::tcp::acceptor after(io, {asio::ip::make_address("127.0.0.1"), port});
+    CHECK(after.is_open());
+}
+
+TEST_CASE("a library without the MHD functions fails naming the missing function") {
+    asio::io_context io;
+    try {
+        HttpEndpoint endpoint(io, any_loopback_port, sample_text, {}, "libc.so.6");
+        FAIL("the constructor must throw");
+    } catch (const MetricsHttpError& error) {
+        const std::string message = error.what();
+        CHECK(message.find("libc.so.6 has no MHD_start_daemon") != std::string::npos);
+        CHECK(message.find("apt install libmicrohttpd12") != std::string::npos);
+    }
+}
+
 TEST_CASE("closing the endpoint frees its port at once") {
     asio::io_context io;
     std::uint16_t port = 0;
