@@ -55,10 +55,10 @@ void set(T& target, const Field<T>& field) {
             rule.clients.push_back(*c);
         }
         for (const auto& u : raw_rule.units.items) {
-            rule.units.push_back(static_cast<std::uint8_t>(*u));
+            rule.units.emplace_back(static_cast<std::uint8_t>(*u));
         }
         for (const auto& f : raw_rule.functions.items) {
-            rule.functions.push_back(static_cast<std::uint8_t>(*f));
+            rule.functions.emplace_back(static_cast<std::uint8_t>(*f));
         }
         if (raw_rule.registers.ok()) {
             rule.registers = RegisterRange{static_cast<std::uint16_t>(*raw_rule.registers.from),

@@ -49,7 +49,7 @@ template <class T>
 
 }  // namespace
 
-bool AccessRule::matches(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+bool AccessRule::matches(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                          std::optional<RegisterRange> request) const noexcept {
     const bool client_matches =
         clients.empty() || std::any_of(clients.begin(), clients.end(), [&](const Cidr& c) { return c.contains(client); });
@@ -72,7 +72,7 @@ bool ModbusTcpConfig::client_allowed(const IpAddress& client) const noexcept {
     return allow.empty() || std::any_of(allow.begin(), allow.end(), [&](const Cidr& c) { return c.contains(client); });
 }
 
-RuleAction ModbusTcpConfig::decide(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+RuleAction ModbusTcpConfig::decide(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                                    std::optional<RegisterRange> request) const noexcept {
     for (const auto& rule : rules) {
         if (rule.matches(client, unit, function, request)) {

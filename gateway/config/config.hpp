@@ -21,6 +21,7 @@
 #include "config/net_address.hpp"
 #include "core/device_type.hpp"
 #include "core/log_level.hpp"
+#include "core/modbus_ids.hpp"
 #include "core/parity.hpp"
 #include "core/register_table.hpp"
 #include "core/word_order.hpp"
@@ -94,8 +95,8 @@ struct RegisterRange {
 /// One access rule. An empty list matches anything.
 struct AccessRule {
     std::vector<Cidr> clients;
-    std::vector<std::uint8_t> units;      ///< must be configured unit IDs
-    std::vector<std::uint8_t> functions;  ///< function codes 1..127
+    std::vector<core::UnitId> units;            ///< must be configured unit IDs
+    std::vector<core::FunctionCode> functions;  ///< function codes 1..127
     std::optional<RegisterRange> registers;
     RuleAction action = RuleAction::deny;  ///< required in the file
 
@@ -104,7 +105,7 @@ struct AccessRule {
     /// A deny rule matches a request that touches any register of its range; an
     /// allow rule only a request that lies entirely inside it. A rule with a
     /// register range never matches a request without registers (e.g. FC07).
-    [[nodiscard]] bool matches(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+    [[nodiscard]] bool matches(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                                std::optional<RegisterRange> request) const noexcept;
     bool operator==(const AccessRule&) const = default;
 };
@@ -128,7 +129,7 @@ struct ModbusTcpConfig {
     /// The allow-list (empty = any client).
     [[nodiscard]] bool client_allowed(const IpAddress& client) const noexcept;
     /// The first matching rule decides; no match allows. Call after client_allowed().
-    [[nodiscard]] RuleAction decide(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+    [[nodiscard]] RuleAction decide(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                                     std::optional<RegisterRange> request) const noexcept;
     bool operator==(const ModbusTcpConfig&) const = default;
 };

@@ -202,7 +202,7 @@ void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, proto
     ConnectionContext& context = *context_;
     ++context.stats.requests;
     const RequestScope scope = request_scope(pdu);
-    const core::FunctionCode function{scope.function};
+    const core::FunctionCode function = scope.function;
     UnitTarget* target = context.routes.find(unit.value);
     // A broadcast unit answers for the units of its line: a request it may carry
     // must be allowed for each of them too (docs/modbus-tcp.md, "Broadcast units").

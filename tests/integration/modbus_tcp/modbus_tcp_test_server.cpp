@@ -41,8 +41,8 @@ int main(int argc, char** argv) {
         }
     }
     config::AccessRule protect;
-    protect.units = {2};
-    protect.functions = {0x06, 0x10, 0x17};
+    protect.units = {core::UnitId{2}};
+    protect.functions = {core::FunctionCode{0x06}, core::FunctionCode{0x10}, core::FunctionCode{0x17}};
     protect.registers = config::RegisterRange{100, 199};
     protect.action = config::RuleAction::deny;
     config.rules = {protect};
