@@ -174,7 +174,7 @@ struct DeviceConfig {
     std::string name;                           ///< required; unique in the whole config
     DeviceType type = DeviceType::modbus;       ///< required
     std::uint8_t address = 0;                   ///< required; see address_range()
-    std::uint8_t unit_id = 0;                   ///< required; unique across the config
+    core::UnitId unit_id;                       ///< required; unique across the config
     milliseconds max_age{200};                  ///< image freshness for TCP reads; 0: always ask
     static constexpr Range<milliseconds> max_age_range{milliseconds{0}, std::chrono::hours{1}};
     milliseconds command_ttl{500};              ///< a command not started by then is rejected
@@ -226,7 +226,7 @@ struct LineConfig {
     unsigned offline_after = 3;  ///< consecutive timeouts
     static constexpr Range<std::int64_t> offline_after_range{1, 100};
     Backoff offline_backoff{seconds{1}, seconds{30}};
-    std::optional<std::uint8_t> broadcast_unit;  ///< Modbus TCP unit that broadcasts on this line
+    std::optional<core::UnitId> broadcast_unit;  ///< Modbus TCP unit that broadcasts on this line
     /// Percent of the line's time its broadcasts may take (frame + t3.5 +
     /// broadcast_delay each); a broadcast beyond it is refused with 0x06, so polls and
     /// the other devices keep their rates.
@@ -242,8 +242,8 @@ struct LineConfig {
 };
 
 struct UpstreamUnitConfig {
-    std::uint8_t unit_id = 0;        ///< required; gateway unit, unique across the config
-    std::uint8_t upstream_unit = 1;  ///< unit on the upstream (the R6 manual's examples use 1)
+    core::UnitId unit_id;                   ///< required; gateway unit, unique across the config
+    core::UnitId upstream_unit{1};          ///< unit on the upstream (the R6 manual's examples use 1)
     std::string name;                ///< required; MQTT device name, unique with device names
     bool operator==(const UpstreamUnitConfig&) const = default;
 };

@@ -95,7 +95,7 @@ engine::Duration LineBroadcastTarget::line_time(const std::vector<BroadcastStep>
     return total;
 }
 
-void LineBroadcastTarget::handle(std::uint8_t /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
+void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
                                  PduHandler done) {
     asio::io_context& io = shared_->io;
     auto op = std::make_shared<Operation>();

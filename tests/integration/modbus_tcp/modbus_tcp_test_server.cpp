@@ -57,8 +57,8 @@ int main(int argc, char** argv) {
         northbound::modbus_tcp::ModbusTcpServer server(io, std::make_shared<const config::ModbusTcpConfig>(config), log);
         ImmediateTarget unit1(io);
         ImmediateTarget unit2(io);
-        server.routes().set(1, unit1);
-        server.routes().set(2, unit2);
+        server.routes().set(core::UnitId{1}, unit1);
+        server.routes().set(core::UnitId{2}, unit2);
         server.start();
         asio::signal_set signals(io, SIGTERM, SIGINT);
         signals.async_wait([&](const asio::error_code&, int) {

@@ -50,7 +50,7 @@ fieldbridge::config::UpstreamConfig config_for(std::uint16_t port) {
     c.poll_period = milliseconds{100};
     c.command_ttl = milliseconds{2000};
     c.queue_limit = 64;
-    c.units = {{10, 1, "robot"}};
+    c.units = {{fieldbridge::core::UnitId{10}, fieldbridge::core::UnitId{1}, "robot"}};
     return c;
 }
 
