@@ -31,9 +31,9 @@ Range<std::uint8_t> address_range(DeviceType type) noexcept {
     return {1, 247};
 }
 
-std::uint8_t broadcast_address(DeviceType type) noexcept {
+core::BusAddress broadcast_address(DeviceType type) noexcept {
     // Seed 002 section 5: "廣播地址: 0xFF"; every other manual uses the Modbus 0.
-    return type == DeviceType::excd203mb ? std::uint8_t{0xFF} : std::uint8_t{0};
+    return core::BusAddress{type == DeviceType::excd203mb ? std::uint8_t{0xFF} : std::uint8_t{0}};
 }
 
 bool has_register_pairs(DeviceType type) noexcept {

@@ -62,7 +62,7 @@ enum class MqttVersion { v3_1_1, v5 };
 [[nodiscard]] Range<std::uint8_t> address_range(DeviceType type) noexcept;
 /// The broadcast address on the bus for @p type: 0xFF for EXCD203MB (seed 002
 /// section 5), 0 for the others.
-[[nodiscard]] std::uint8_t broadcast_address(DeviceType type) noexcept;
+[[nodiscard]] core::BusAddress broadcast_address(DeviceType type) noexcept;
 /// Types with 32-bit values spread over two registers, where `word_order` applies.
 [[nodiscard]] bool has_register_pairs(DeviceType type) noexcept;
 
@@ -173,7 +173,7 @@ struct RegisterBlock {
 struct DeviceConfig {
     std::string name;                           ///< required; unique in the whole config
     DeviceType type = DeviceType::modbus;       ///< required
-    std::uint8_t address = 0;                   ///< required; see address_range()
+    core::BusAddress address;                   ///< required; see address_range()
     core::UnitId unit_id;                       ///< required; unique across the config
     milliseconds max_age{200};                  ///< image freshness for TCP reads; 0: always ask
     static constexpr Range<milliseconds> max_age_range{milliseconds{0}, std::chrono::hours{1}};

@@ -151,7 +151,7 @@ void LineBroadcastTarget::submit_step(const std::shared_ptr<Shared>& shared, con
     const BroadcastStep& step = op->steps[op->next];
     engine::Transaction transaction;
     transaction.device = engine::broadcast_device;
-    transaction.address = step.address;
+    transaction.address = step.address.value;  // the line's Transaction carries the byte
     transaction.payload = step.payload;
     transaction.priority = engine::Priority::command;
     transaction.urgent = step.urgent;          // rule 4

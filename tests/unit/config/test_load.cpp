@@ -12,6 +12,7 @@
 using namespace fieldbridge::config;
 using namespace fieldbridge::config::test;
 using namespace std::chrono_literals;
+using fieldbridge::core::BusAddress;
 using fieldbridge::core::UnitId;
 
 namespace {
@@ -96,13 +97,13 @@ TEST_CASE("the demo configuration describes the demo cell") {
     CHECK(a.broadcast_unit == UnitId{100});
     REQUIRE(a.devices.size() == 3);
     CHECK(a.devices[0].type == DeviceType::hiwin_xeg);
-    CHECK(a.devices[0].address == 2);
+    CHECK(a.devices[0].address == BusAddress{2});
     CHECK(a.devices[0].unit_id == UnitId{1});
     CHECK(a.devices[1].type == DeviceType::excd203mb);
-    CHECK(a.devices[1].address == 3);
+    CHECK(a.devices[1].address == BusAddress{3});
     CHECK(a.devices[1].unit_id == UnitId{2});
     CHECK(a.devices[2].type == DeviceType::wtec_ascii);
-    CHECK(a.devices[2].address == 5);
+    CHECK(a.devices[2].address == BusAddress{5});
     CHECK(a.devices[2].unit_id == UnitId{3});
     CHECK(a.devices[2].stroke == 20000U);
 
@@ -111,7 +112,7 @@ TEST_CASE("the demo configuration describes the demo cell") {
     CHECK(b.port == "/tmp/fieldbridge-demo/line-b");
     REQUIRE(b.devices.size() == 1);
     CHECK(b.devices[0].type == DeviceType::wtec_rtu);
-    CHECK(b.devices[0].address == 1);
+    CHECK(b.devices[0].address == BusAddress{1});
     CHECK(b.devices[0].unit_id == UnitId{4});
 
     REQUIRE(config->upstreams.size() == 1);
@@ -302,7 +303,7 @@ lines:
     CHECK(line.local_echo);
     CHECK(line.read_retries == 0);
     const auto& device = line.devices.at(0);
-    CHECK(device.address == 0x10);
+    CHECK(device.address == BusAddress{0x10});
     CHECK(device.unit_id == UnitId{0x20});
     REQUIRE(device.blocks.size() == 2);
     CHECK(device.blocks[0].table == RegisterTable::discrete_inputs);
@@ -388,6 +389,6 @@ TEST_CASE("enum spellings") {
     CHECK(to_string(RegisterTable::discrete_inputs) == "discrete_inputs");
     CHECK(address_range(DeviceType::hiwin_xeg).max == 15);
     CHECK(address_range(DeviceType::excd203mb).max == 254);
-    CHECK(broadcast_address(DeviceType::excd203mb) == 0xFF);
-    CHECK(broadcast_address(DeviceType::wtec_rtu) == 0);
+    CHECK(broadcast_address(DeviceType::excd203mb) == BusAddress{0xFF});
+    CHECK(broadcast_address(DeviceType::wtec_rtu) == BusAddress{0});
 }
