@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < clients; ++i) {
         pool[i].fd = connect_loopback(port);
         pool[i].request = protocol::encode_mbap(
-            static_cast<std::uint16_t>(i), 1,
+            static_cast<std::uint16_t>(i), core::UnitId{1},
             protocol::encode_request(protocol::ReadRegistersRequest{0x03, 0x0300, registers}));
         pool[i].expected = response_size;
         fds[i] = pollfd{pool[i].fd, POLLIN, 0};

@@ -147,7 +147,7 @@ void Connection::process() {
         rx_begin_ += frame.consumed;
         // The next frame's first byte arrived at the latest now.
         last_activity_ = frame_started_ = Clock::now();
-        dispatch(frame.value.transaction_id, core::UnitId{frame.value.unit_id}, frame.value.pdu);
+        dispatch(frame.value.transaction_id, frame.value.unit_id, frame.value.pdu);
     }
     if (closed_ || draining_) return;
     // Keep the partial frame at the front so the buffer always has room for a whole one.

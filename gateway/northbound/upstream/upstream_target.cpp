@@ -214,7 +214,7 @@ private:
         if (link_->state() == LinkState::up) {
             while (auto dispatch = scheduler_.next(now)) {
                 ++stats_.forwarded;
-                link_->send(protocol::encode_mbap(dispatch->transaction_id, dispatch->unit.value, dispatch->pdu));
+                link_->send(protocol::encode_mbap(dispatch->transaction_id, dispatch->unit, dispatch->pdu));
             }
         } else {
             scheduler_.tick(now);  // commands still expire while connecting
@@ -283,7 +283,7 @@ private:
     }
 
     void on_frame(protocol::MbapFrame frame) {
-        if (scheduler_.reply(frame.transaction_id, core::UnitId{frame.unit_id}, std::move(frame.pdu), Clock::now())) {
+        if (scheduler_.reply(frame.transaction_id, frame.unit_id, std::move(frame.pdu), Clock::now())) {
             ++stats_.replies;
         } else {
             ++stats_.late_replies;

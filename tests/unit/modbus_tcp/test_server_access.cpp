@@ -44,7 +44,7 @@ TEST_CASE("access rules: denied requests get exception 0x01 and the target never
     auto response = client.ask(write_register(1, 1, 150, 7));
     REQUIRE(response);
     CHECK(response->transaction_id == 1);
-    CHECK(response->unit_id == 1);
+    CHECK(response->unit_id == core::UnitId{1});
     CHECK(response->pdu == exception_pdu(0x06, 0x01));
     CHECK(seen(0) == 0);
 
@@ -71,7 +71,7 @@ TEST_CASE("access rules: denied requests get exception 0x01 and the target never
     response = client.ask(read_registers(7, 2, 0, 1, 0x04));  // another function
     REQUIRE(response);
     CHECK(response->pdu == exception_pdu(0x04, 0x01));
-    response = client.ask(protocol::encode_mbap(8, 2, Bytes{0x07}));  // FC07: no registers, denied by rule 3
+    response = client.ask(protocol::encode_mbap(8, core::UnitId{2}, Bytes{0x07}));  // FC07: no registers, denied by rule 3
     REQUIRE(response);
     CHECK(response->pdu == exception_pdu(0x07, 0x01));
     CHECK(seen(1) == 1);
