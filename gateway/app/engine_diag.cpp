@@ -62,7 +62,7 @@ json EngineDiag::collect(const engine::Engine& eng, engine::TimePoint now) {
             const engine::DeviceStats* stats = worker.scheduler().stats(agent->config().index);
             json d{{"name", agent->config().name}, {"online", agent->online()}};
             for (const engine::DeviceEntry& entry : eng.devices()) {
-                if (entry.agent == agent.get()) d["unit_id"] = entry.unit_id;
+                if (entry.agent == agent.get()) d["unit_id"] = entry.unit_id.value;
             }
             if (stats != nullptr) {
                 std::uint64_t submitted = 0;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "app/engine_component.hpp"
+#include "core/modbus_ids.hpp"
 #include "daemon/component.hpp"
 #include "northbound/modbus_tcp/server.hpp"
 #include "northbound/targets/line_broadcast_target.hpp"
@@ -69,7 +70,7 @@ private:
         const engine::LineWorker* worker = nullptr;
         std::uint64_t revision = 0;
         std::vector<std::unique_ptr<northbound::UnitTarget>> targets;
-        std::vector<std::uint8_t> units;
+        std::vector<core::UnitId> units;
     };
     std::map<std::string, LineTargets, std::less<>> line_targets_;  ///< by line name
     std::vector<std::function<void()>> upstreams_closing_;

@@ -55,10 +55,10 @@ void set(T& target, const Field<T>& field) {
             rule.clients.push_back(*c);
         }
         for (const auto& u : raw_rule.units.items) {
-            rule.units.push_back(static_cast<std::uint8_t>(*u));
+            rule.units.emplace_back(static_cast<std::uint8_t>(*u));
         }
         for (const auto& f : raw_rule.functions.items) {
-            rule.functions.push_back(static_cast<std::uint8_t>(*f));
+            rule.functions.emplace_back(static_cast<std::uint8_t>(*f));
         }
         if (raw_rule.registers.ok()) {
             rule.registers = RegisterRange{static_cast<std::uint16_t>(*raw_rule.registers.from),
@@ -74,8 +74,8 @@ void set(T& target, const Field<T>& field) {
     DeviceConfig device;
     device.name = *raw.name;
     device.type = *raw.type;
-    device.address = static_cast<std::uint8_t>(*raw.address);
-    device.unit_id = static_cast<std::uint8_t>(*raw.unit_id);
+    device.address = core::BusAddress{static_cast<std::uint8_t>(*raw.address)};
+    device.unit_id = core::UnitId{static_cast<std::uint8_t>(*raw.unit_id)};
     set(device.max_age, raw.max_age);
     set(device.command_ttl, raw.command_ttl);
     set(device.delay_before_command, raw.delay_before_command);
@@ -119,7 +119,7 @@ void set(T& target, const Field<T>& field) {
     line.offline_after = narrow<unsigned>(raw.offline_after, line.offline_after);
     line.offline_backoff = build_backoff(raw.offline_backoff, line.offline_backoff);
     if (raw.broadcast_unit.has_value()) {
-        line.broadcast_unit = static_cast<std::uint8_t>(*raw.broadcast_unit);
+        line.broadcast_unit = core::UnitId{static_cast<std::uint8_t>(*raw.broadcast_unit)};
     }
     line.broadcast_share = narrow<unsigned>(raw.broadcast_share, line.broadcast_share);
     for (const auto& device : raw.devices.items) {
@@ -142,8 +142,8 @@ void set(T& target, const Field<T>& field) {
     upstream.queue_limit = narrow<std::size_t>(raw.queue_limit, upstream.queue_limit);
     for (const auto& raw_unit : raw.units.items) {
         UpstreamUnitConfig unit;
-        unit.unit_id = static_cast<std::uint8_t>(*raw_unit.unit_id);
-        unit.upstream_unit = narrow<std::uint8_t>(raw_unit.upstream_unit, unit.upstream_unit);
+        unit.unit_id = core::UnitId{static_cast<std::uint8_t>(*raw_unit.unit_id)};
+        unit.upstream_unit = core::UnitId{narrow<std::uint8_t>(raw_unit.upstream_unit, unit.upstream_unit.value)};
         unit.name = *raw_unit.name;
         upstream.units.push_back(std::move(unit));
     }

@@ -31,9 +31,9 @@ Range<std::uint8_t> address_range(DeviceType type) noexcept {
     return {1, 247};
 }
 
-std::uint8_t broadcast_address(DeviceType type) noexcept {
+core::BusAddress broadcast_address(DeviceType type) noexcept {
     // Seed 002 section 5: "廣播地址: 0xFF"; every other manual uses the Modbus 0.
-    return type == DeviceType::excd203mb ? std::uint8_t{0xFF} : std::uint8_t{0};
+    return core::BusAddress{type == DeviceType::excd203mb ? std::uint8_t{0xFF} : std::uint8_t{0}};
 }
 
 bool has_register_pairs(DeviceType type) noexcept {
@@ -49,7 +49,7 @@ template <class T>
 
 }  // namespace
 
-bool AccessRule::matches(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+bool AccessRule::matches(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                          std::optional<RegisterRange> request) const noexcept {
     const bool client_matches =
         clients.empty() || std::any_of(clients.begin(), clients.end(), [&](const Cidr& c) { return c.contains(client); });
@@ -72,7 +72,7 @@ bool ModbusTcpConfig::client_allowed(const IpAddress& client) const noexcept {
     return allow.empty() || std::any_of(allow.begin(), allow.end(), [&](const Cidr& c) { return c.contains(client); });
 }
 
-RuleAction ModbusTcpConfig::decide(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+RuleAction ModbusTcpConfig::decide(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                                    std::optional<RegisterRange> request) const noexcept {
     for (const auto& rule : rules) {
         if (rule.matches(client, unit, function, request)) {

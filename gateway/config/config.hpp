@@ -21,6 +21,7 @@
 #include "config/net_address.hpp"
 #include "core/device_type.hpp"
 #include "core/log_level.hpp"
+#include "core/modbus_ids.hpp"
 #include "core/parity.hpp"
 #include "core/register_table.hpp"
 #include "core/word_order.hpp"
@@ -61,7 +62,7 @@ enum class MqttVersion { v3_1_1, v5 };
 [[nodiscard]] Range<std::uint8_t> address_range(DeviceType type) noexcept;
 /// The broadcast address on the bus for @p type: 0xFF for EXCD203MB (seed 002
 /// section 5), 0 for the others.
-[[nodiscard]] std::uint8_t broadcast_address(DeviceType type) noexcept;
+[[nodiscard]] core::BusAddress broadcast_address(DeviceType type) noexcept;
 /// Types with 32-bit values spread over two registers, where `word_order` applies.
 [[nodiscard]] bool has_register_pairs(DeviceType type) noexcept;
 
@@ -94,8 +95,8 @@ struct RegisterRange {
 /// One access rule. An empty list matches anything.
 struct AccessRule {
     std::vector<Cidr> clients;
-    std::vector<std::uint8_t> units;      ///< must be configured unit IDs
-    std::vector<std::uint8_t> functions;  ///< function codes 1..127
+    std::vector<core::UnitId> units;            ///< must be configured unit IDs
+    std::vector<core::FunctionCode> functions;  ///< function codes 1..127
     std::optional<RegisterRange> registers;
     RuleAction action = RuleAction::deny;  ///< required in the file
 
@@ -104,7 +105,7 @@ struct AccessRule {
     /// A deny rule matches a request that touches any register of its range; an
     /// allow rule only a request that lies entirely inside it. A rule with a
     /// register range never matches a request without registers (e.g. FC07).
-    [[nodiscard]] bool matches(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+    [[nodiscard]] bool matches(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                                std::optional<RegisterRange> request) const noexcept;
     bool operator==(const AccessRule&) const = default;
 };
@@ -128,7 +129,7 @@ struct ModbusTcpConfig {
     /// The allow-list (empty = any client).
     [[nodiscard]] bool client_allowed(const IpAddress& client) const noexcept;
     /// The first matching rule decides; no match allows. Call after client_allowed().
-    [[nodiscard]] RuleAction decide(const IpAddress& client, std::uint8_t unit, std::uint8_t function,
+    [[nodiscard]] RuleAction decide(const IpAddress& client, core::UnitId unit, core::FunctionCode function,
                                     std::optional<RegisterRange> request) const noexcept;
     bool operator==(const ModbusTcpConfig&) const = default;
 };
@@ -172,8 +173,8 @@ struct RegisterBlock {
 struct DeviceConfig {
     std::string name;                           ///< required; unique in the whole config
     DeviceType type = DeviceType::modbus;       ///< required
-    std::uint8_t address = 0;                   ///< required; see address_range()
-    std::uint8_t unit_id = 0;                   ///< required; unique across the config
+    core::BusAddress address;                   ///< required; see address_range()
+    core::UnitId unit_id;                       ///< required; unique across the config
     milliseconds max_age{200};                  ///< image freshness for TCP reads; 0: always ask
     static constexpr Range<milliseconds> max_age_range{milliseconds{0}, std::chrono::hours{1}};
     milliseconds command_ttl{500};              ///< a command not started by then is rejected
@@ -225,7 +226,7 @@ struct LineConfig {
     unsigned offline_after = 3;  ///< consecutive timeouts
     static constexpr Range<std::int64_t> offline_after_range{1, 100};
     Backoff offline_backoff{seconds{1}, seconds{30}};
-    std::optional<std::uint8_t> broadcast_unit;  ///< Modbus TCP unit that broadcasts on this line
+    std::optional<core::UnitId> broadcast_unit;  ///< Modbus TCP unit that broadcasts on this line
     /// Percent of the line's time its broadcasts may take (frame + t3.5 +
     /// broadcast_delay each); a broadcast beyond it is refused with 0x06, so polls and
     /// the other devices keep their rates.
@@ -241,8 +242,8 @@ struct LineConfig {
 };
 
 struct UpstreamUnitConfig {
-    std::uint8_t unit_id = 0;        ///< required; gateway unit, unique across the config
-    std::uint8_t upstream_unit = 1;  ///< unit on the upstream (the R6 manual's examples use 1)
+    core::UnitId unit_id;                   ///< required; gateway unit, unique across the config
+    core::UnitId upstream_unit{1};          ///< unit on the upstream (the R6 manual's examples use 1)
     std::string name;                ///< required; MQTT device name, unique with device names
     bool operator==(const UpstreamUnitConfig&) const = default;
 };

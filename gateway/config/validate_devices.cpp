@@ -25,7 +25,7 @@ void check_address(const RawDevice& device, DiagnosticSink& sink) {
         "expected " + std::to_string(range.min) + ".." + std::to_string(range.max) + " for " + type_name(type);
     // 0 is the Modbus broadcast address (Modbus over serial line V1.02 section 2.1);
     // the EXCD203MB broadcasts on 0xFF instead (seed 002 section 5).
-    if (*address == 0 || *address == broadcast_address(type)) {
+    if (*address == 0 || *address == broadcast_address(type).value) {
         const std::string which =
             *address == 0 ? "0 is the broadcast address" : "0xFF (255) is the EXCD203MB broadcast address";
         sink.error(address, which + " and cannot be a device address (configure a line broadcast_unit to "

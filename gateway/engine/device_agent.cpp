@@ -126,7 +126,7 @@ void DeviceAgent::Impl::on_health(bool online, TimePoint now) {
 Transaction DeviceAgent::Impl::transaction(Payload payload, Priority priority) const {
     Transaction t;
     t.device = config_.index;
-    t.address = config_.address;
+    t.address = config_.address.value;  // the line's Transaction carries the byte
     t.payload = std::move(payload);
     t.priority = priority;
     return t;
@@ -185,7 +185,7 @@ void DeviceAgent::Impl::log(LogLevel level, std::string_view message) const { lo
 
 std::string DeviceAgent::Impl::who() const {
     return "device '" + config_.name + "' (line '" + config_.line_name + "', address " +
-           std::to_string(config_.address) + ")";
+           std::to_string(config_.address.value) + ")";
 }
 
 }  // namespace fieldbridge::engine

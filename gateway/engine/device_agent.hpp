@@ -45,6 +45,7 @@
 #include <memory>
 #include <string>
 
+#include "core/modbus_ids.hpp"
 #include "engine/line_log.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "engine/register_image.hpp"
@@ -57,7 +58,7 @@ struct DeviceAgentConfig {
     std::string name;             ///< the device's config name, for logs and MQTT
     std::string line_name;
     DeviceIndex index = 0;        ///< its index on the line's scheduler
-    std::uint8_t address = 1;     ///< bus address
+    core::BusAddress address{1};
     Duration max_age = std::chrono::milliseconds{0};          ///< 0: never serve reads from the image
     Duration command_ttl = std::chrono::milliseconds{500};    ///< deadline of commands
     Duration delay_before_command{};                          ///< rule 11

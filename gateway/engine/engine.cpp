@@ -47,7 +47,7 @@ namespace {
         device->command_ttl = {};
         device->delay_before_command = {};
         device->queue_limit = 0;
-        device->unit_id = 0;
+        device->unit_id = {};
         device->mqtt_commands = false;
     }
     return left == right;
@@ -158,7 +158,7 @@ void Engine::index_devices() {
         for (const auto& agent : line.agents) {
             const auto* device = find_device_config(line.config, agent->config().name);
             devices_.push_back(DeviceEntry{line.worker->config().name, agent.get(),
-                                           device != nullptr ? device->unit_id : std::uint8_t{0},
+                                           device != nullptr ? device->unit_id : core::UnitId{},
                                            device == nullptr || device->mqtt_commands});
         }
     }
@@ -305,7 +305,7 @@ void Engine::stop() {
     for (auto& line : lines_) line.worker->stop();
 }
 
-DeviceAgent* Engine::find_unit(std::uint8_t unit_id) const noexcept {
+DeviceAgent* Engine::find_unit(core::UnitId unit_id) const noexcept {
     for (const auto& device : devices_) {
         if (device.unit_id == unit_id) return device.agent;
     }

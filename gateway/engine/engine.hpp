@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "config/config.hpp"
+#include "core/modbus_ids.hpp"
 #include "engine/device_agent.hpp"
 #include "engine/line_log.hpp"
 #include "engine/line_worker.hpp"
@@ -34,7 +35,7 @@ using PortFactory = std::function<std::unique_ptr<SerialPort>(const SerialSettin
 struct DeviceEntry {
     std::string_view line;
     DeviceAgent* agent = nullptr;
-    std::uint8_t unit_id = 0;
+    core::UnitId unit_id;
     bool mqtt_commands = true;
 };
 
@@ -44,7 +45,7 @@ struct LineEntry {
     /// In configuration order; each agent's config().index is its scheduler index
     /// (indices are not reused within a line: a swapped device gets a new one).
     std::vector<std::unique_ptr<DeviceAgent>> agents;
-    std::optional<std::uint8_t> broadcast_unit;
+    std::optional<core::UnitId> broadcast_unit;
     /// The line's shortest command_ttl: a broadcast acts no later than any of its
     /// devices would accept a command.
     Duration broadcast_ttl = std::chrono::milliseconds{500};
@@ -99,7 +100,7 @@ public:
     ReloadReport apply(const config::Config& config);
 
     /// By Modbus TCP unit ID; nullptr when no serial device has it.
-    [[nodiscard]] DeviceAgent* find_unit(std::uint8_t unit_id) const noexcept;
+    [[nodiscard]] DeviceAgent* find_unit(core::UnitId unit_id) const noexcept;
     /// By configured device name; nullptr when unknown.
     [[nodiscard]] DeviceAgent* find_device(std::string_view name) const noexcept;
     [[nodiscard]] const std::vector<DeviceEntry>& devices() const noexcept { return devices_; }

@@ -12,6 +12,7 @@
 #include <span>
 
 #include "config/net_address.hpp"
+#include "core/modbus_ids.hpp"
 #include "protocol/bytes.hpp"
 
 namespace fieldbridge::northbound {
@@ -34,11 +35,11 @@ public:
     UnitTarget& operator=(const UnitTarget&) = delete;
 
     /// @p request_pdu is a complete PDU as received (function code first).
-    virtual void handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
+    virtual void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
                         PduHandler done) = 0;
     /// Units whose access rules this target's requests must pass too, besides its own
     /// unit: a line's broadcast unit reaches every unit of its line.
-    [[nodiscard]] virtual std::span<const std::uint8_t> ruled_as() const noexcept { return {}; }
+    [[nodiscard]] virtual std::span<const core::UnitId> ruled_as() const noexcept { return {}; }
     /// The client's connection closed: drop its state, answer nothing more to it.
     virtual void client_closed(std::uint64_t /*connection*/) {}
 };

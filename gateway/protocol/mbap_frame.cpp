@@ -23,7 +23,7 @@ constexpr std::size_t bytes_before_length_payload = unit_offset;
 
 }  // namespace
 
-Bytes encode_mbap(std::uint16_t transaction_id, std::uint8_t unit_id, ByteView pdu) {
+Bytes encode_mbap(std::uint16_t transaction_id, core::UnitId unit_id, ByteView pdu) {
     if (pdu.empty() || pdu.size() > mbap_max_length - 1U) {
         throw core::InvalidArgument("Modbus TCP frame (transaction " + std::to_string(transaction_id) +
                                     "): PDU of " + std::to_string(pdu.size()) +
@@ -34,7 +34,7 @@ Bytes encode_mbap(std::uint16_t transaction_id, std::uint8_t unit_id, ByteView p
     put_u16_be(out, transaction_id);
     put_u16_be(out, 0);  // protocol identifier: 0 = Modbus
     put_u16_be(out, static_cast<std::uint16_t>(pdu.size() + 1));
-    out.push_back(unit_id);
+    out.push_back(unit_id.value);
     out.insert(out.end(), pdu.begin(), pdu.end());
     return out;
 }
@@ -57,7 +57,7 @@ DecodeResult<MbapFrame> decode_mbap(ByteView stream) {
     const std::size_t frame_size = bytes_before_length_payload + length;
     if (size < frame_size) return MbapResult::more();
     const ByteView pdu = stream.subspan(mbap_header_size, frame_size - mbap_header_size);
-    return MbapResult::ok(MbapFrame{get_u16_be(stream, transaction_offset), stream[unit_offset],
+    return MbapResult::ok(MbapFrame{get_u16_be(stream, transaction_offset), core::UnitId{stream[unit_offset]},
                                     Bytes(pdu.begin(), pdu.end())},
                           frame_size);
 }

@@ -43,7 +43,7 @@ public:
         response_ = protocol::encode_response(
             protocol::ReadRegistersResponse{0x03, std::vector<std::uint16_t>(registers, 0x1234)});
     }
-    void handle(std::uint8_t, protocol::ByteView, const northbound::ClientRef&, northbound::PduHandler done) override {
+    void handle(core::UnitId, protocol::ByteView, const northbound::ClientRef&, northbound::PduHandler done) override {
         asio::post(io_, [this, done = std::move(done)] { done(response_); });
     }
 
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
     config.max_connections = clients + 1;
     northbound::modbus_tcp::ModbusTcpServer server(io, std::make_shared<const config::ModbusTcpConfig>(config), {});
     CachedTarget target(io, registers);
-    server.routes().set(1, target);
+    server.routes().set(core::UnitId{1}, target);
     server.start();
     const auto port = server.port();
     auto work = asio::make_work_guard(io);
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < clients; ++i) {
         pool[i].fd = connect_loopback(port);
         pool[i].request = protocol::encode_mbap(
-            static_cast<std::uint16_t>(i), 1,
+            static_cast<std::uint16_t>(i), core::UnitId{1},
             protocol::encode_request(protocol::ReadRegistersRequest{0x03, 0x0300, registers}));
         pool[i].expected = response_size;
         fds[i] = pollfd{pool[i].fd, POLLIN, 0};

@@ -68,13 +68,13 @@ void modbus_seeds(const std::vector<Vector>& vectors, const fs::path& out) {
         const Bytes request = fieldbridge::test::parse_hex(v.request);
         if (request.size() < 4) continue;
         const auto request_pdu = pdu_of(request);
-        const Bytes as_mbap = protocol::encode_mbap(++transaction, request[0], request_pdu);
+        const Bytes as_mbap = protocol::encode_mbap(++transaction, fieldbridge::core::UnitId{request[0]}, request_pdu);
         mbap.write(concat({Bytes{0x11}, as_mbap}));
         stream.insert(stream.end(), as_mbap.begin(), as_mbap.end());
         if (!v.response || !v.response_crc_ok) continue;
         const Bytes response = fieldbridge::test::parse_hex(*v.response);
         if (response.size() < 4) continue;
-        mbap.write(concat({Bytes{0x00}, protocol::encode_mbap(transaction, response[0], pdu_of(response))}));
+        mbap.write(concat({Bytes{0x00}, protocol::encode_mbap(transaction, fieldbridge::core::UnitId{response[0]}, pdu_of(response))}));
         const Bytes length{static_cast<std::uint8_t>(request_pdu.size())};
         // Split byte 0x00, then the same with 3 bytes of noise ahead of the reply.
         rtu.write(concat({Bytes{0x00}, length, request_pdu, Bytes{request[0]}, response}));

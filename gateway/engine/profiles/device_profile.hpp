@@ -23,6 +23,7 @@
 
 #include "core/device_type.hpp"
 #include "core/error.hpp"
+#include "core/modbus_ids.hpp"
 #include "core/word_order.hpp"
 #include "engine/profiles/operations.hpp"
 #include "engine/profiles/poll_plan.hpp"
@@ -55,7 +56,7 @@ struct GenericBlock {
 
 /// Everything a profile takes from the configuration (mapped by the glue layer).
 struct ProfileOptions {
-    std::uint8_t address = 1;  ///< bus address (the WTEC ASCII view shows it at 0x0303)
+    core::BusAddress address{1};  ///< the WTEC ASCII view shows it at 0x0303
     PollPeriods poll;
     bool allow_protected = false;                  ///< device ID / flash save / baud / mode writes
     WordOrder word_order = WordOrder::high_first;  ///< excd203mb
@@ -136,7 +137,7 @@ public:
     [[nodiscard]] virtual DeviceType type() const noexcept = 0;
     [[nodiscard]] virtual Bus bus() const noexcept = 0;
     /// 0, or 0xFF for EXCD203MB (seed 002 §5).
-    [[nodiscard]] virtual std::uint8_t broadcast_address() const noexcept = 0;
+    [[nodiscard]] virtual core::BusAddress broadcast_address() const noexcept = 0;
 
     /// Spec §4: the exception to answer locally, without touching the line: 0x01
     /// unsupported function code or protected register not enabled, 0x02 address

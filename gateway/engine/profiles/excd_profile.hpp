@@ -26,7 +26,7 @@ public:
     explicit ExcdProfile(const ProfileOptions& options);
 
     [[nodiscard]] DeviceType type() const noexcept override { return DeviceType::excd203mb; }
-    [[nodiscard]] std::uint8_t broadcast_address() const noexcept override { return 0xFF; }
+    [[nodiscard]] core::BusAddress broadcast_address() const noexcept override { return core::BusAddress{0xFF}; }
     [[nodiscard]] bool in_motion(const RegisterImage& image) const override;
     [[nodiscard]] DecodedState decode_state(const RegisterImage& image) const override;
     [[nodiscard]] std::vector<Alarm> alarms(const RegisterImage& image) const override;

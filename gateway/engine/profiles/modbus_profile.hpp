@@ -27,7 +27,7 @@ struct WireFunctions {
 class ModbusProfile : public DeviceProfile {
 public:
     [[nodiscard]] Bus bus() const noexcept override { return Bus::modbus_rtu; }
-    [[nodiscard]] std::uint8_t broadcast_address() const noexcept override { return 0; }
+    [[nodiscard]] core::BusAddress broadcast_address() const noexcept override { return core::BusAddress{0}; }
 
     [[nodiscard]] std::optional<protocol::ExceptionCode> validate(const protocol::Request& request,
                                                                   const RegisterImage& image) const override;

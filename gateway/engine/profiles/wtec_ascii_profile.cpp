@@ -330,7 +330,7 @@ void WtecAsciiProfile::refresh_gateway_registers(RegisterImage& image, TimePoint
     // The e-stop latch lives here: 0 when the gateway starts (it cannot know about
     // an earlier `a0`), refreshed with every answer so reads of it stay fresh.
     const std::uint16_t latch = image.value(Table::holding, estop).value_or(0);
-    const std::uint16_t id = image.value(Table::holding, device_id).value_or(options_.address);
+    const std::uint16_t id = image.value(Table::holding, device_id).value_or(options_.address.value);
     image.update(Table::holding, estop, std::array<std::uint16_t, 1>{latch}, now);
     image.update(Table::holding, device_id, std::array<std::uint16_t, 1>{id}, now);
 }

@@ -64,7 +64,7 @@ public:
 
     [[nodiscard]] DeviceType type() const noexcept override { return DeviceType::wtec_ascii; }
     [[nodiscard]] Bus bus() const noexcept override { return Bus::wtec_ascii; }
-    [[nodiscard]] std::uint8_t broadcast_address() const noexcept override { return 0; }
+    [[nodiscard]] core::BusAddress broadcast_address() const noexcept override { return core::BusAddress{0}; }
 
     [[nodiscard]] std::optional<protocol::ExceptionCode> validate(const protocol::Request& request,
                                                                   const RegisterImage& image) const override;

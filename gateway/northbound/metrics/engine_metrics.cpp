@@ -4,6 +4,7 @@
 #include <chrono>
 #include <string>
 
+#include "core/modbus_ids.hpp"
 #include "northbound/metrics/latency_histogram.hpp"
 
 namespace fieldbridge::northbound::metrics {
@@ -48,10 +49,10 @@ void collect_line(MetricSet& out, const engine::LineWorker& worker) {
 }
 
 void collect_device(MetricSet& out, const engine::LineWorker& worker, const engine::DeviceAgent& agent,
-                    std::uint8_t unit_id) {
+                    core::UnitId unit_id) {
     const Labels device{{"line", worker.config().name},
                         {"device", agent.config().name},
-                        {"unit", std::to_string(unit_id)}};
+                        {"unit", std::to_string(unit_id.value)}};
     out.add_gauge("fieldbridge_device_online", "1 while the device answers, 0 once it is offline", device,
                   agent.online() ? 1 : 0);
     const engine::DeviceStats* stats = worker.scheduler().stats(agent.config().index);

@@ -45,9 +45,9 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
         scope.first = every_register;
         return scope;
     }
-    scope.function = pdu[0];
+    scope.function = core::FunctionCode{pdu[0]};
     namespace fc = protocol::fc;
-    switch (scope.function) {
+    switch (scope.function.value) {
         case fc::read_coils:
         case fc::read_discrete_inputs:
         case fc::read_holding_registers:
@@ -71,7 +71,7 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
             }
             break;
         default:
-            if (touches_no_register(scope.function)) return scope;
+            if (touches_no_register(scope.function.value)) return scope;
             break;  // FC08, 14, 15, 18, 2B, vendor codes: what they touch is not known
     }
     // A PDU too short for its address fields, or a function code whose registers
@@ -84,7 +84,7 @@ bool request_allowed(const config::ModbusTcpConfig& config, const config::IpAddr
                      const RequestScope& scope) noexcept {
     if (config.rules.empty()) return true;
     const auto allowed = [&](std::optional<config::RegisterRange> range) {
-        return config.decide(client, unit.value, scope.function, range) == config::RuleAction::allow;
+        return config.decide(client, unit, scope.function, range) == config::RuleAction::allow;
     };
     return allowed(scope.first) && (!scope.second || allowed(scope.second));
 }

@@ -21,7 +21,7 @@ namespace fieldbridge::northbound::modbus_tcp {
 
 /// What a request touches.
 struct RequestScope {
-    std::uint8_t function = 0;
+    core::FunctionCode function;  ///< the PDU's first byte (0 for an empty PDU)
     /// FC01-06, 0F, 10: the addressed coils / inputs / registers; FC22 (0x16, mask write):
     /// its register; FC17: the read range; unknown: 0x0000-0xFFFF; FC07, 0B, 0C, 11: none.
     std::optional<config::RegisterRange> first;

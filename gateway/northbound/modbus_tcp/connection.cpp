@@ -147,7 +147,7 @@ void Connection::process() {
         rx_begin_ += frame.consumed;
         // The next frame's first byte arrived at the latest now.
         last_activity_ = frame_started_ = Clock::now();
-        dispatch(frame.value.transaction_id, core::UnitId{frame.value.unit_id}, frame.value.pdu);
+        dispatch(frame.value.transaction_id, frame.value.unit_id, frame.value.pdu);
     }
     if (closed_ || draining_) return;
     // Keep the partial frame at the front so the buffer always has room for a whole one.
@@ -202,16 +202,16 @@ void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, proto
     ConnectionContext& context = *context_;
     ++context.stats.requests;
     const RequestScope scope = request_scope(pdu);
-    const core::FunctionCode function{scope.function};
-    UnitTarget* target = context.routes.find(unit.value);
+    const core::FunctionCode function = scope.function;
+    UnitTarget* target = context.routes.find(unit);
     // A broadcast unit answers for the units of its line: a request it may carry
     // must be allowed for each of them too (docs/modbus-tcp.md, "Broadcast units").
     const auto denied = [&] {
         if (!request_allowed(*context.config, client_.address, unit, scope)) return true;
         if (target == nullptr) return false;
-        const std::span<const std::uint8_t> also = target->ruled_as();
-        return std::any_of(also.begin(), also.end(), [&](std::uint8_t covered) {
-            return !request_allowed(*context.config, client_.address, core::UnitId{covered}, scope);
+        const std::span<const core::UnitId> also = target->ruled_as();
+        return std::any_of(also.begin(), also.end(), [&](core::UnitId covered) {
+            return !request_allowed(*context.config, client_.address, covered, scope);
         });
     };
     if (denied()) {
@@ -246,7 +246,7 @@ void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, proto
     try {
         // The handler keeps this connection (not its socket: close() releases that)
         // so that an answer arriving after the close is counted and dropped here.
-        target->handle(unit.value, pdu, client_,
+        target->handle(unit, pdu, client_,
                        [self = shared_from_this(), index, generation](protocol::Bytes response) {
                            self->complete(index, generation, std::move(response));
                        });

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/modbus_ids.hpp"
 #include "northbound/unit_target.hpp"
 
 namespace fieldbridge::northbound::modbus_tcp {
@@ -19,12 +20,12 @@ namespace fieldbridge::northbound::modbus_tcp {
 class UnitRouter {
 public:
     /// Routes @p unit to @p target (replacing any previous route of that unit).
-    void set(std::uint8_t unit, UnitTarget& target) noexcept { targets_[unit] = &target; }
-    void remove(std::uint8_t unit) noexcept { targets_[unit] = nullptr; }
+    void set(core::UnitId unit, UnitTarget& target) noexcept { targets_[unit.value] = &target; }
+    void remove(core::UnitId unit) noexcept { targets_[unit.value] = nullptr; }
     void clear() noexcept { targets_.fill(nullptr); }
 
     /// nullptr when the unit has no route.
-    [[nodiscard]] UnitTarget* find(std::uint8_t unit) const noexcept { return targets_[unit]; }
+    [[nodiscard]] UnitTarget* find(core::UnitId unit) const noexcept { return targets_[unit.value]; }
     /// Units with a route.
     [[nodiscard]] std::size_t size() const noexcept;
     /// Every routed target once (a target may serve several units), in unit order.

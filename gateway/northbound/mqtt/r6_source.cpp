@@ -6,6 +6,7 @@
 #include <asio/post.hpp>
 
 #include "core/error.hpp"
+#include "core/modbus_ids.hpp"
 #include "protocol/gateway_exceptions.hpp"
 #include "northbound/upstream/r6_operations.hpp"
 
@@ -20,7 +21,7 @@ constexpr std::uint64_t mqtt_connection = 0xFFFF'FFFF'FFFF'FF00ULL;
 /// Shared by the sources of one target: the target's one state callback fans out.
 struct Hub {
     upstream::UpstreamTarget* target = nullptr;
-    std::map<std::uint8_t, std::shared_ptr<SourceListener>> listeners;
+    std::map<core::UnitId, std::shared_ptr<SourceListener>> listeners;
 };
 
 class R6Source final : public DeviceSource {
@@ -105,7 +106,7 @@ public:
 private:
     asio::io_context& io_;
     std::shared_ptr<Hub> hub_;
-    std::uint8_t unit_;
+    core::UnitId unit_;
     std::string name_;
     std::shared_ptr<SourceListener> listener_;
 };

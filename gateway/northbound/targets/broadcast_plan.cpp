@@ -10,7 +10,7 @@ using protocol::ExceptionCode;
 
 /// The devices on one bus address.
 struct Group {
-    std::uint8_t address = 0;
+    core::BusAddress address;
     std::optional<std::vector<engine::Payload>> payloads;  ///< of the first device that accepts
     std::optional<ExceptionCode> refusal;                  ///< of the first device that refuses
     bool disagree = false;                                 ///< accepting devices need different payloads
@@ -44,7 +44,7 @@ BroadcastPlan plan_broadcast(const protocol::Request& request, std::span<const B
     for (const BroadcastMember& member : members) {
         const engine::DeviceProfile& profile = *member.profile;
         if (profile.bus() != engine::Bus::modbus_rtu) continue;  // hears no Modbus broadcast
-        const std::uint8_t address = profile.broadcast_address();
+        const core::BusAddress address = profile.broadcast_address();
         auto found = std::find_if(groups.begin(), groups.end(), [&](const Group& g) { return g.address == address; });
         if (found == groups.end()) {
             groups.emplace_back().address = address;

@@ -22,6 +22,7 @@
 #include <span>
 #include <vector>
 
+#include "core/modbus_ids.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "engine/register_image.hpp"
 #include "engine/transaction.hpp"
@@ -38,7 +39,7 @@ struct BroadcastMember {
 
 /// One transaction of the broadcast.
 struct BroadcastStep {
-    std::uint8_t address = 0;  ///< 0 or 0xFF
+    core::BusAddress address;  ///< 0 or 0xFF
     engine::Payload payload;
     engine::Duration delay_before{};  ///< the longest of the devices it reaches
     bool urgent = false;              ///< a stop for every device it reaches (rule 4)

@@ -95,7 +95,7 @@ engine::Duration LineBroadcastTarget::line_time(const std::vector<BroadcastStep>
     return total;
 }
 
-void LineBroadcastTarget::handle(std::uint8_t /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
+void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
                                  PduHandler done) {
     asio::io_context& io = shared_->io;
     auto op = std::make_shared<Operation>();
@@ -151,7 +151,7 @@ void LineBroadcastTarget::submit_step(const std::shared_ptr<Shared>& shared, con
     const BroadcastStep& step = op->steps[op->next];
     engine::Transaction transaction;
     transaction.device = engine::broadcast_device;
-    transaction.address = step.address;
+    transaction.address = step.address.value;  // the line's Transaction carries the byte
     transaction.payload = step.payload;
     transaction.priority = engine::Priority::command;
     transaction.urgent = step.urgent;          // rule 4

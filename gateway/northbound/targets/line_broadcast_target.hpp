@@ -24,6 +24,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/modbus_ids.hpp"
 #include "engine/device_agent.hpp"
 #include "engine/line_worker.hpp"
 #include "engine/transaction.hpp"
@@ -36,7 +37,7 @@ namespace fieldbridge::northbound {
 /// A device of the broadcast's line and its Modbus TCP unit.
 struct LineUnit {
     engine::DeviceAgent* agent = nullptr;
-    std::uint8_t unit_id = 0;
+    core::UnitId unit_id;
 };
 
 struct BroadcastSettings {
@@ -54,9 +55,9 @@ public:
                         BroadcastSettings settings);
     ~LineBroadcastTarget() override;
 
-    void handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
+    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
                 PduHandler done) override;
-    [[nodiscard]] std::span<const std::uint8_t> ruled_as() const noexcept override { return units_; }
+    [[nodiscard]] std::span<const core::UnitId> ruled_as() const noexcept override { return units_; }
 
 private:
     struct Shared;
@@ -66,7 +67,7 @@ private:
 
     std::shared_ptr<Shared> shared_;
     std::vector<LineUnit> devices_;
-    std::vector<std::uint8_t> units_;
+    std::vector<core::UnitId> units_;
     BroadcastBudget budget_;
 };
 

@@ -16,7 +16,7 @@ void SerialDeviceTarget::answer(PduHandler done, protocol::Bytes pdu) {
     asio::post(io_, [done = std::move(done), pdu = std::move(pdu)]() mutable { done(std::move(pdu)); });
 }
 
-void SerialDeviceTarget::handle(std::uint8_t /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
+void SerialDeviceTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
                                 PduHandler done) {
     const auto decoded = protocol::decode_request(request_pdu);
     const std::uint8_t function = request_pdu.empty() ? 0 : request_pdu[0];

@@ -23,7 +23,7 @@ public:
     /// routes before rebuilding the engine).
     SerialDeviceTarget(asio::io_context& io, engine::DeviceAgent& agent, const engine::LineWorker& line);
 
-    void handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
+    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
                 PduHandler done) override;
 
 private:

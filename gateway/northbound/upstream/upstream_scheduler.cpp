@@ -127,7 +127,7 @@ std::optional<Dispatch> UpstreamScheduler::next(TimePoint now) {
     if (log_.enabled(engine::LogLevel::debug)) {
         log_(engine::LogLevel::debug,
              fmt::format("upstream: sending txid {} FC{:02X} unit {} ({}, client {})", d.transaction_id,
-                         function_of(d.pdu), d.unit, entry.request.poll ? "poll" : "request",
+                         function_of(d.pdu), d.unit.value, entry.request.poll ? "poll" : "request",
                          entry.request.client));
     }
     flight_.push_back(std::move(entry));
@@ -191,7 +191,7 @@ void UpstreamScheduler::release(Resource resource, const char* why) {
     lock.owner.reset();
 }
 
-bool UpstreamScheduler::reply(std::uint16_t transaction_id, std::uint8_t unit, protocol::Bytes pdu,
+bool UpstreamScheduler::reply(std::uint16_t transaction_id, core::UnitId unit, protocol::Bytes pdu,
                               TimePoint now) {
     const auto it = std::find_if(flight_.begin(), flight_.end(), [&](const Entry& e) {
         return e.transaction_id == transaction_id && e.request.unit == unit;
@@ -199,7 +199,7 @@ bool UpstreamScheduler::reply(std::uint16_t transaction_id, std::uint8_t unit, p
     if (it == flight_.end()) {
         log_(engine::LogLevel::debug,
              fmt::format("upstream: dropped a reply with txid {} unit {}: no request waits for it "
-                         "(a late answer to a timed-out request)", transaction_id, unit));
+                         "(a late answer to a timed-out request)", transaction_id, unit.value));
         return false;
     }
     Entry entry = std::move(*it);
@@ -241,7 +241,7 @@ void UpstreamScheduler::tick(TimePoint now) {
             ++consecutive_timeouts_;
             log_(engine::LogLevel::warning,
                  fmt::format("upstream: no reply to txid {} FC{:02X} unit {} within {} ms; answered 0x0B "
-                             "(not retried)", it->transaction_id, function_of(it->request.pdu), it->request.unit,
+                             "(not retried)", it->transaction_id, function_of(it->request.pdu), it->request.unit.value,
                              std::chrono::duration_cast<std::chrono::milliseconds>(settings_.response_timeout).count()));
             Entry entry = std::move(*it);
             it = flight_.erase(it);

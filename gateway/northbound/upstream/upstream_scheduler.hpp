@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "core/modbus_ids.hpp"
 #include "engine/line_log.hpp"
 #include "engine/transaction.hpp"
 #include "northbound/upstream/request_class.hpp"
@@ -59,7 +60,7 @@ using UpstreamDone = std::function<void(const UpstreamOutcome&)>;
 struct UpstreamRequest {
     std::uint64_t client = 0;  ///< the client connection (ClientRef::connection)
     bool poll = false;         ///< the gateway's own state polling (no client)
-    std::uint8_t unit = 1;     ///< the unit ID on the upstream
+    core::UnitId unit{1};      ///< the unit ID on the upstream
     protocol::Bytes pdu;
     RequestClass request_class;
     UpstreamDone done;
@@ -80,7 +81,7 @@ struct SchedulerSettings {
 /// A request to put on the connection now.
 struct Dispatch {
     std::uint16_t transaction_id = 0;
-    std::uint8_t unit = 0;
+    core::UnitId unit;
     protocol::Bytes pdu;
 };
 
@@ -100,7 +101,7 @@ public:
     [[nodiscard]] std::optional<Dispatch> next(TimePoint now);
     /// A reply frame from the upstream. False when no request in flight has that
     /// transaction ID and unit (a late reply to a request that timed out): dropped.
-    bool reply(std::uint16_t transaction_id, std::uint8_t unit, protocol::Bytes pdu, TimePoint now);
+    bool reply(std::uint16_t transaction_id, core::UnitId unit, protocol::Bytes pdu, TimePoint now);
     /// Response timeouts, command deadlines and lapsed sequences up to @p now.
     void tick(TimePoint now);
     /// The connection dropped or the target stops: requests in flight complete

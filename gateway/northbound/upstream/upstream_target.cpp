@@ -104,7 +104,7 @@ public:
         }
     }
 
-    void handle(std::uint8_t unit_id, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
+    void handle(core::UnitId unit_id, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
         ++stats_.requests;
         const std::uint8_t function = pdu.empty() ? 0 : pdu[0];
         const Unit* unit = find(unit_id);
@@ -147,7 +147,7 @@ public:
     /// A reply that does not fit its request (an exception of another length than 2,
     /// another quantity, a byte count its data does not match, another echo of a
     /// write) never reaches the client: it would read garbage as data.
-    [[nodiscard]] bool reply_malformed(std::uint8_t unit_id, const protocol::Bytes& asked,
+    [[nodiscard]] bool reply_malformed(core::UnitId unit_id, const protocol::Bytes& asked,
                                        const protocol::Bytes& reply) {
         const auto request = protocol::decode_request(asked);
         if (!request.complete()) return false;  // the client's own business (it was forwarded as it came)
@@ -158,7 +158,7 @@ public:
             log_(engine::LogLevel::warning,
                  fmt::format("upstream {}: unit {} sent a malformed reply to function 0x{:02X} ({}; {} bytes, "
                              "first 0x{:02X}); the client gets exception 0x04, nothing of it is passed on",
-                             config_.name, unit_id, asked.empty() ? 0 : asked[0],
+                             config_.name, unit_id.value, asked.empty() ? 0 : asked[0],
                              protocol::to_string(decoded.error), reply.size(), reply.empty() ? 0 : reply[0]));
         }
         return true;
@@ -171,11 +171,11 @@ public:
 
     void set_state_callback(R6StateCallback callback) { state_callback_ = std::move(callback); }
 
-    [[nodiscard]] const R6State* state(std::uint8_t unit_id) const {
+    [[nodiscard]] const R6State* state(core::UnitId unit_id) const {
         const Unit* unit = find(unit_id);
         return unit == nullptr ? nullptr : &unit->state;
     }
-    [[nodiscard]] const engine::RegisterImage* image(std::uint8_t unit_id) const {
+    [[nodiscard]] const engine::RegisterImage* image(core::UnitId unit_id) const {
         const Unit* unit = find(unit_id);
         return unit == nullptr ? nullptr : &unit->image;
     }
@@ -198,7 +198,7 @@ private:
         bool cycle_failed = false;
     };
 
-    [[nodiscard]] Unit* find(std::uint8_t unit_id) const {
+    [[nodiscard]] Unit* find(core::UnitId unit_id) const {
         const auto it = std::find_if(units_.begin(), units_.end(),
                                      [unit_id](const auto& u) { return u->config.unit_id == unit_id; });
         return it == units_.end() ? nullptr : it->get();
@@ -339,7 +339,7 @@ private:
             request.pdu = protocol::encode_request(*read);
             request.request_class.priority = engine::Priority::poll;
             std::weak_ptr<Impl> weak = weak_from_this();
-            const std::uint8_t unit_id = unit.config.unit_id;
+            const core::UnitId unit_id = unit.config.unit_id;
             const std::uint64_t cycle = unit.cycle;
             request.done = [weak, unit_id, cycle, read = *read](const UpstreamOutcome& outcome) {
                 if (auto self = weak.lock()) self->on_poll_reply(unit_id, cycle, read, outcome);
@@ -355,7 +355,7 @@ private:
         ++unit.cycle;
     }
 
-    void on_poll_reply(std::uint8_t unit_id, std::uint64_t cycle, const protocol::ReadRegistersRequest& read,
+    void on_poll_reply(core::UnitId unit_id, std::uint64_t cycle, const protocol::ReadRegistersRequest& read,
                        const UpstreamOutcome& outcome) {
         Unit* unit = find(unit_id);
         if (unit == nullptr || !unit->cycle_running || unit->cycle != cycle || stopped_) return;
@@ -448,7 +448,7 @@ UpstreamTarget::~UpstreamTarget() {
 void UpstreamTarget::start() { impl_->start(); }
 void UpstreamTarget::stop() { impl_->stop(); }
 
-void UpstreamTarget::handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
+void UpstreamTarget::handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
                             PduHandler done) {
     impl_->handle(unit, request_pdu, client, std::move(done));
 }
@@ -459,13 +459,13 @@ void UpstreamTarget::set_state_callback(R6StateCallback callback) {
     impl_->set_state_callback(std::move(callback));
 }
 
-std::optional<R6State> UpstreamTarget::state(std::uint8_t unit) const {
+std::optional<R6State> UpstreamTarget::state(core::UnitId unit) const {
     const R6State* s = impl_->state(unit);
     if (s == nullptr) return std::nullopt;
     return *s;
 }
 
-const engine::RegisterImage* UpstreamTarget::image(std::uint8_t unit) const { return impl_->image(unit); }
+const engine::RegisterImage* UpstreamTarget::image(core::UnitId unit) const { return impl_->image(unit); }
 LinkState UpstreamTarget::link_state() const noexcept { return impl_->link_state(); }
 UpstreamStats UpstreamTarget::stats() const noexcept { return impl_->stats(); }
 const config::UpstreamConfig& UpstreamTarget::config() const noexcept { return impl_->config(); }

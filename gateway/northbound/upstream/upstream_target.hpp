@@ -30,6 +30,7 @@
 #include <asio/io_context.hpp>
 
 #include "config/config.hpp"
+#include "core/modbus_ids.hpp"
 #include "engine/line_log.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "engine/register_image.hpp"
@@ -54,7 +55,7 @@ struct UpstreamTuning {
 
 /// The decoded state of one R6 unit, for MQTT.
 struct R6State {
-    std::uint8_t unit_id = 0;  ///< the gateway unit
+    core::UnitId unit_id;      ///< the gateway unit
     std::string name;          ///< the unit's MQTT device name
     bool online = false;       ///< the connection is up and the last poll cycle was answered
     engine::DecodedState state;
@@ -89,15 +90,15 @@ public:
     /// Closes the connection, answers everything outstanding 0x0A. Idempotent.
     void stop();
 
-    void handle(std::uint8_t unit, protocol::ByteView request_pdu, const ClientRef& client,
+    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
                 PduHandler done) override;
     void client_closed(std::uint64_t connection) override;
 
     void set_state_callback(R6StateCallback callback);
     /// The last decoded state of gateway unit @p unit; nullopt for a unit not mapped here.
-    [[nodiscard]] std::optional<R6State> state(std::uint8_t unit) const;
+    [[nodiscard]] std::optional<R6State> state(core::UnitId unit) const;
     /// The register image of gateway unit @p unit (nullptr when not mapped here).
-    [[nodiscard]] const engine::RegisterImage* image(std::uint8_t unit) const;
+    [[nodiscard]] const engine::RegisterImage* image(core::UnitId unit) const;
 
     [[nodiscard]] LinkState link_state() const noexcept;
     [[nodiscard]] UpstreamStats stats() const noexcept;

@@ -41,8 +41,8 @@ int main(int argc, char** argv) {
         }
     }
     config::AccessRule protect;
-    protect.units = {2};
-    protect.functions = {0x06, 0x10, 0x17};
+    protect.units = {core::UnitId{2}};
+    protect.functions = {core::FunctionCode{0x06}, core::FunctionCode{0x10}, core::FunctionCode{0x17}};
     protect.registers = config::RegisterRange{100, 199};
     protect.action = config::RuleAction::deny;
     config.rules = {protect};
@@ -57,8 +57,8 @@ int main(int argc, char** argv) {
         northbound::modbus_tcp::ModbusTcpServer server(io, std::make_shared<const config::ModbusTcpConfig>(config), log);
         ImmediateTarget unit1(io);
         ImmediateTarget unit2(io);
-        server.routes().set(1, unit1);
-        server.routes().set(2, unit2);
+        server.routes().set(core::UnitId{1}, unit1);
+        server.routes().set(core::UnitId{2}, unit2);
         server.start();
         asio::signal_set signals(io, SIGTERM, SIGINT);
         signals.async_wait([&](const asio::error_code&, int) {

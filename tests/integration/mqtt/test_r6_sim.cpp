@@ -37,7 +37,7 @@ TEST_CASE("R6 units on MQTT: decoded state, alarm raise / clear, commands throug
         upstream.host = "127.0.0.1";
         upstream.port = static_cast<std::uint16_t>(r6_port);
         upstream.poll_period = std::chrono::milliseconds{100};
-        upstream.units = {fieldbridge::config::UpstreamUnitConfig{10, 1, "robot"}};
+        upstream.units = {fieldbridge::config::UpstreamUnitConfig{fieldbridge::core::UnitId{10}, fieldbridge::core::UnitId{1}, "robot"}};
         fu::UpstreamTarget target(io, upstream, fieldbridge::engine::LogSink{});
         target.start();
 

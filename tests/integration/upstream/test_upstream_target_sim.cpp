@@ -57,7 +57,7 @@ Bytes pdu_of(const char* frame) {
 /// One request through the target, answered within the bound.
 Bytes ask(asio::io_context& io, UpstreamTarget& target, const Bytes& pdu, std::uint64_t who = 1) {
     auto answer = std::make_shared<Answer>();
-    target.handle(10, pdu, client(who), capture(answer));
+    target.handle(core::UnitId{10}, pdu, client(who), capture(answer));
     REQUIRE_MESSAGE(run_until(io, [&] { return answer->done; }, milliseconds{5000}), "no answer to " << to_hex(pdu));
     return answer->pdu;
 }
@@ -110,15 +110,15 @@ TEST_CASE("two clients reading counters concurrently each get their own counter"
         auto b_read = std::make_shared<Answer>();
         const bool a_first = round % 2 == 0;
         if (a_first) {
-            r.target->handle(10, select0, client(1), capture(a_sel));
-            r.target->handle(10, select1, client(2), capture(b_sel));
+            r.target->handle(core::UnitId{10}, select0, client(1), capture(a_sel));
+            r.target->handle(core::UnitId{10}, select1, client(2), capture(b_sel));
         } else {
-            r.target->handle(10, select1, client(2), capture(b_sel));
-            r.target->handle(10, select0, client(1), capture(a_sel));
+            r.target->handle(core::UnitId{10}, select1, client(2), capture(b_sel));
+            r.target->handle(core::UnitId{10}, select0, client(1), capture(a_sel));
         }
-        r.target->handle(10, read, client(1), capture(a_read));
+        r.target->handle(core::UnitId{10}, read, client(1), capture(a_read));
         if (round % 3 == 0) r.io.poll();  // sometimes let the first exchanges run in between
-        r.target->handle(10, read, client(2), capture(b_read));
+        r.target->handle(core::UnitId{10}, read, client(2), capture(b_read));
         REQUIRE(run_until(r.io, [&] { return a_read->done && b_read->done; }, milliseconds{5000}));
         CHECK(a_sel->pdu == hex("10 08 83 00 02"));
         CHECK(b_sel->pdu == hex("10 08 83 00 02"));
@@ -139,13 +139,13 @@ TEST_CASE("the simulator dies and comes back: 0x0A / 0x0B meanwhile, then it wor
     CHECK((during == hex("83 0A") || during == hex("83 0B")));
     REQUIRE(run_until(r.io, [&] { return r.target->link_state() != LinkState::up; }));
     CHECK(ask(r.io, *r.target, hex("03 08 db 00 01")) == hex("83 0A"));
-    REQUIRE(r.target->state(10));
-    CHECK_FALSE(r.target->state(10)->online);
+    REQUIRE(r.target->state(core::UnitId{10}));
+    CHECK_FALSE(r.target->state(core::UnitId{10})->online);
     r.sim.start();
     REQUIRE(run_until(r.io, [&] { return r.target->link_state() == LinkState::up; }, milliseconds{5000}));
     CHECK(ask(r.io, *r.target, hex("03 08 db 00 01")) == hex("03 02 00 06"));
     CHECK(r.target->stats().connects == 2);
-    REQUIRE(run_until(r.io, [&] { return r.target->state(10)->online; }));
+    REQUIRE(run_until(r.io, [&] { return r.target->state(core::UnitId{10})->online; }));
 }
 
 TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle times") {
@@ -153,7 +153,7 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
     std::vector<R6State> reports;
     r.target->set_state_callback([&reports](const R6State& s) { reports.push_back(s); });
     const auto field = [&](const char* name) -> std::optional<engine::Field> {
-        const auto s = r.target->state(10);
+        const auto s = r.target->state(core::UnitId{10});
         if (!s) return std::nullopt;
         const engine::Field* f = s->state.find(name);
         if (f == nullptr) return std::nullopt;
@@ -164,12 +164,12 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
         if (!f || !std::holds_alternative<std::int64_t>(f->value)) return std::nullopt;
         return std::get<std::int64_t>(f->value);
     };
-    REQUIRE(run_until(r.io, [&] { return r.target->state(10)->online && int_of("axis_count"); }));
+    REQUIRE(run_until(r.io, [&] { return r.target->state(core::UnitId{10})->online && int_of("axis_count"); }));
     CHECK(int_of("mode") == 3);
     CHECK(int_of("alarm") == 0);
     CHECK(int_of("axis_count") == 6);
     CHECK(int_of("cycle_time") == 0);
-    CHECK(r.target->state(10)->name == "robot");
+    CHECK(r.target->state(core::UnitId{10})->name == "robot");
     REQUIRE(field("axes_deg"));
     CHECK(std::get<std::vector<double>>(field("axes_deg")->value).size() == 6);
     REQUIRE(field("world_mm"));
@@ -180,8 +180,8 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
     REQUIRE_FALSE(reports.empty());  // the change was reported
     CHECK(reports.back().online);
     CHECK(reports.back().alarms.size() == 1);
-    REQUIRE(r.target->state(10)->alarms.size() == 1);
-    CHECK(r.target->state(10)->alarms[0].code == "r6_alarm_805");
+    REQUIRE(r.target->state(core::UnitId{10})->alarms.size() == 1);
+    CHECK(r.target->state(core::UnitId{10})->alarms[0].code == "r6_alarm_805");
     REQUIRE(r.sim.control("r6 clear") == "ok");
     // Started through the pass-through (start button 0x4E23), as a PLC would.
     CHECK(ask(r.io, *r.target, hex("06 4e 23 00 01")) == hex("06 4e 23 00 01"));
@@ -193,13 +193,13 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
                int_of("cycle_time").value_or(0) > 0;
     }));
     CHECK(int_of("mode") == 2);
-    CHECK(r.target->state(10)->alarms.empty());
-    const auto image = r.target->image(10);
+    CHECK(r.target->state(core::UnitId{10})->alarms.empty());
+    const auto image = r.target->image(core::UnitId{10});
     REQUIRE(image != nullptr);
     CHECK(image->quality(engine::Table::holding, 0x09A6) == engine::Quality::good);
     const std::size_t before = reports.size();
     r.sim.kill();
-    REQUIRE(run_until(r.io, [&] { return !r.target->state(10)->online; }));
+    REQUIRE(run_until(r.io, [&] { return !r.target->state(core::UnitId{10})->online; }));
     CHECK(reports.size() > before);
     CHECK_FALSE(reports.back().online);
     CHECK(image->quality(engine::Table::holding, 0x09A6) == engine::Quality::offline);

@@ -70,7 +70,7 @@ private:
                 close();
                 return;
             }
-            auto reply = server_.answer(result.value.transaction_id, result.value.unit_id,
+            auto reply = server_.answer(result.value.transaction_id, result.value.unit_id.value,
                                         result.value.pdu);
             tx_pending_.insert(tx_pending_.end(), reply.begin(), reply.end());
             rx_.erase(rx_.begin(), rx_.begin() + static_cast<std::ptrdiff_t>(result.consumed));
@@ -211,7 +211,7 @@ protocol::Bytes ModbusTcpServer::answer(std::uint16_t transaction_id, std::uint8
     if ((reply[0] & protocol::fc::exception_flag) != 0) {
         ++counters_.exceptions;
     }
-    return protocol::encode_mbap(transaction_id, unit_id, reply);
+    return protocol::encode_mbap(transaction_id, core::UnitId{unit_id}, reply);
 }
 
 nlohmann::json ModbusTcpServer::stats() const {

@@ -7,6 +7,8 @@
 
 using namespace fieldbridge::config;
 using namespace fieldbridge::config::test;
+using fieldbridge::core::FunctionCode;
+using fieldbridge::core::UnitId;
 
 namespace {
 
@@ -16,9 +18,9 @@ IpAddress ip(const char* text) {
     return *address;
 }
 
-constexpr std::uint8_t fc03 = 3;
-constexpr std::uint8_t fc07 = 7;
-constexpr std::uint8_t fc16 = 16;
+constexpr FunctionCode fc03{3};
+constexpr FunctionCode fc07{7};
+constexpr FunctionCode fc16{16};
 
 }  // namespace
 
@@ -49,27 +51,27 @@ modbus_tcp:
 
     const RegisterRange move{0x0630, 0x0632};
     // SCADA network: no writes at all, reads pass.
-    CHECK(tcp.decide(ip("10.1.2.3"), 1, fc16, move) == RuleAction::deny);
-    CHECK(tcp.decide(ip("10.1.2.3"), 2, fc16, RegisterRange{0x0100, 0x0101}) == RuleAction::deny);
-    CHECK(tcp.decide(ip("10.1.2.3"), 1, fc03, RegisterRange{0x0300, 0x0301}) == RuleAction::allow);
+    CHECK(tcp.decide(ip("10.1.2.3"), UnitId{1}, fc16, move) == RuleAction::deny);
+    CHECK(tcp.decide(ip("10.1.2.3"), UnitId{2}, fc16, RegisterRange{0x0100, 0x0101}) == RuleAction::deny);
+    CHECK(tcp.decide(ip("10.1.2.3"), UnitId{1}, fc03, RegisterRange{0x0300, 0x0301}) == RuleAction::allow);
     // The PLC may write the motion registers of unit 1...
-    CHECK(tcp.decide(ip("10.2.0.10"), 1, fc16, move) == RuleAction::allow);
+    CHECK(tcp.decide(ip("10.2.0.10"), UnitId{1}, fc16, move) == RuleAction::allow);
     // ...but an allow rule covers only requests entirely inside its range; the deny
     // rule then matches a request that touches the range.
-    CHECK(tcp.decide(ip("10.2.0.10"), 1, fc16, RegisterRange{0x0640, 0x0650}) == RuleAction::deny);
+    CHECK(tcp.decide(ip("10.2.0.10"), UnitId{1}, fc16, RegisterRange{0x0640, 0x0650}) == RuleAction::deny);
     // Nobody else writes them.
-    CHECK(tcp.decide(ip("10.3.0.1"), 1, fc16, move) == RuleAction::deny);
-    CHECK(tcp.decide(ip("10.3.0.1"), 1, fc03, RegisterRange{0x0646, 0x0647}) == RuleAction::deny);
+    CHECK(tcp.decide(ip("10.3.0.1"), UnitId{1}, fc16, move) == RuleAction::deny);
+    CHECK(tcp.decide(ip("10.3.0.1"), UnitId{1}, fc03, RegisterRange{0x0646, 0x0647}) == RuleAction::deny);
     // Other units and other registers are not concerned.
-    CHECK(tcp.decide(ip("10.3.0.1"), 2, fc16, move) == RuleAction::allow);
-    CHECK(tcp.decide(ip("10.3.0.1"), 1, fc16, RegisterRange{0x0647, 0x0650}) == RuleAction::allow);
+    CHECK(tcp.decide(ip("10.3.0.1"), UnitId{2}, fc16, move) == RuleAction::allow);
+    CHECK(tcp.decide(ip("10.3.0.1"), UnitId{1}, fc16, RegisterRange{0x0647, 0x0650}) == RuleAction::allow);
     // A request without registers (FC07) never matches a rule with a register range.
-    CHECK(tcp.decide(ip("10.3.0.1"), 1, fc07, std::nullopt) == RuleAction::allow);
+    CHECK(tcp.decide(ip("10.3.0.1"), UnitId{1}, fc07, std::nullopt) == RuleAction::allow);
 }
 
 TEST_CASE("no allow-list and no rules: everything is allowed") {
     const auto config = load_ok("gateway: {id: t}\nmodbus_tcp: {allow: [], rules: []}\n");
     REQUIRE(config);
     CHECK(config->modbus_tcp.client_allowed(ip("203.0.113.9")));
-    CHECK(config->modbus_tcp.decide(ip("203.0.113.9"), 7, fc16, RegisterRange{0, 10}) == RuleAction::allow);
+    CHECK(config->modbus_tcp.decide(ip("203.0.113.9"), UnitId{7}, fc16, RegisterRange{0, 10}) == RuleAction::allow);
 }

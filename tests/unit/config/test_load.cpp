@@ -12,6 +12,8 @@
 using namespace fieldbridge::config;
 using namespace fieldbridge::config::test;
 using namespace std::chrono_literals;
+using fieldbridge::core::BusAddress;
+using fieldbridge::core::UnitId;
 
 namespace {
 
@@ -65,11 +67,11 @@ TEST_CASE("the example configuration loads and uses every section") {
     CHECK(line.devices[3].type == DeviceType::modbus);
     CHECK(line.devices[3].blocks.size() == 3);
     CHECK(line.devices[3].word_order == WordOrder::low_first);
-    CHECK(line.broadcast_unit == std::uint8_t{100});
+    CHECK(line.broadcast_unit == UnitId{100});
     CHECK(line.broadcast_share == 10U);
     CHECK(config->lines[1].devices.at(0).type == DeviceType::wtec_rtu);
     REQUIRE(config->upstreams.size() == 1);
-    CHECK(config->upstreams[0].units.at(0).unit_id == 50);
+    CHECK(config->upstreams[0].units.at(0).unit_id == UnitId{50});
     CHECK(config->mqtt.enabled);
     CHECK(config->mqtt.deadband.at("position_mm") == doctest::Approx(0.05));
     REQUIRE(config->metrics_http.has_value());
@@ -92,17 +94,17 @@ TEST_CASE("the demo configuration describes the demo cell") {
     const auto& a = config->lines[0];
     CHECK(a.name == "line-a");
     CHECK(a.port == "/tmp/fieldbridge-demo/line-a");
-    CHECK(a.broadcast_unit == std::uint8_t{100});
+    CHECK(a.broadcast_unit == UnitId{100});
     REQUIRE(a.devices.size() == 3);
     CHECK(a.devices[0].type == DeviceType::hiwin_xeg);
-    CHECK(a.devices[0].address == 2);
-    CHECK(a.devices[0].unit_id == 1);
+    CHECK(a.devices[0].address == BusAddress{2});
+    CHECK(a.devices[0].unit_id == UnitId{1});
     CHECK(a.devices[1].type == DeviceType::excd203mb);
-    CHECK(a.devices[1].address == 3);
-    CHECK(a.devices[1].unit_id == 2);
+    CHECK(a.devices[1].address == BusAddress{3});
+    CHECK(a.devices[1].unit_id == UnitId{2});
     CHECK(a.devices[2].type == DeviceType::wtec_ascii);
-    CHECK(a.devices[2].address == 5);
-    CHECK(a.devices[2].unit_id == 3);
+    CHECK(a.devices[2].address == BusAddress{5});
+    CHECK(a.devices[2].unit_id == UnitId{3});
     CHECK(a.devices[2].stroke == 20000U);
 
     const auto& b = config->lines[1];
@@ -110,8 +112,8 @@ TEST_CASE("the demo configuration describes the demo cell") {
     CHECK(b.port == "/tmp/fieldbridge-demo/line-b");
     REQUIRE(b.devices.size() == 1);
     CHECK(b.devices[0].type == DeviceType::wtec_rtu);
-    CHECK(b.devices[0].address == 1);
-    CHECK(b.devices[0].unit_id == 4);
+    CHECK(b.devices[0].address == BusAddress{1});
+    CHECK(b.devices[0].unit_id == UnitId{4});
 
     REQUIRE(config->upstreams.size() == 1);
     const auto& r6 = config->upstreams[0];
@@ -119,8 +121,8 @@ TEST_CASE("the demo configuration describes the demo cell") {
     CHECK(r6.host == "127.0.0.1");
     CHECK(r6.port == 15020);
     REQUIRE(r6.units.size() == 1);
-    CHECK(r6.units[0].unit_id == 50);
-    CHECK(r6.units[0].upstream_unit == 1);
+    CHECK(r6.units[0].unit_id == UnitId{50});
+    CHECK(r6.units[0].upstream_unit == UnitId{1});
     CHECK(r6.units[0].name == "r6");
 
     CHECK(config->mqtt.enabled);
@@ -198,7 +200,7 @@ upstreams:
     CHECK(upstream.poll_period == 500ms);
     CHECK(upstream.command_ttl == 1s);
     CHECK(upstream.queue_limit == 32);
-    CHECK(upstream.units.at(0).upstream_unit == 1);
+    CHECK(upstream.units.at(0).upstream_unit == UnitId{1});
 
     CHECK_FALSE(config->mqtt.enabled);  // no mqtt section: MQTT is off
     CHECK_FALSE(config->metrics_http.has_value());
@@ -301,8 +303,8 @@ lines:
     CHECK(line.local_echo);
     CHECK(line.read_retries == 0);
     const auto& device = line.devices.at(0);
-    CHECK(device.address == 0x10);
-    CHECK(device.unit_id == 0x20);
+    CHECK(device.address == BusAddress{0x10});
+    CHECK(device.unit_id == UnitId{0x20});
     REQUIRE(device.blocks.size() == 2);
     CHECK(device.blocks[0].table == RegisterTable::discrete_inputs);
     CHECK(device.blocks[0].count == 2000);
@@ -387,6 +389,6 @@ TEST_CASE("enum spellings") {
     CHECK(to_string(RegisterTable::discrete_inputs) == "discrete_inputs");
     CHECK(address_range(DeviceType::hiwin_xeg).max == 15);
     CHECK(address_range(DeviceType::excd203mb).max == 254);
-    CHECK(broadcast_address(DeviceType::excd203mb) == 0xFF);
-    CHECK(broadcast_address(DeviceType::wtec_rtu) == 0);
+    CHECK(broadcast_address(DeviceType::excd203mb) == BusAddress{0xFF});
+    CHECK(broadcast_address(DeviceType::wtec_rtu) == BusAddress{0});
 }

@@ -228,7 +228,7 @@ inline fe::DeviceAgentConfig test_config() {
     c.name = "gripper1";
     c.line_name = "bus0";
     c.index = 3;
-    c.address = 7;
+    c.address = fieldbridge::core::BusAddress{7};
     c.max_age = 0ms;
     c.command_ttl = 300ms;
     c.delay_before_command = 4ms;

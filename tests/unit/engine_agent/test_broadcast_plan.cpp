@@ -56,11 +56,11 @@ TEST_CASE("broadcast plan: each address gets the write only when every device on
     const auto excd = line.plan(fp::WriteMultipleRegistersRequest{0x0014, {0, 4321}});
     REQUIRE_FALSE(excd.refusal);
     REQUIRE(excd.steps.size() == 1);
-    CHECK(excd.steps[0].address == 0xFF);
+    CHECK(excd.steps[0].address == fieldbridge::core::BusAddress{0xFF});
     // The XEG's FC06 goes out as FC16 to address 0 (seed 001 §4.1).
     const auto xeg = line.plan(fp::WriteSingleRegisterRequest{0x0630, 1234});
     REQUIRE(xeg.steps.size() == 1);
-    CHECK(xeg.steps[0].address == 0x00);
+    CHECK(xeg.steps[0].address == fieldbridge::core::BusAddress{0x00});
     CHECK(sent(xeg.steps[0]) == fp::Request{fp::WriteMultipleRegistersRequest{0x0630, {1234}}});
 }
 

@@ -135,7 +135,7 @@ TEST_CASE("a change on one line leaves the other line's worker, port and queue a
     CHECK(cell.engine.find_device("wtec") != nullptr);
     CHECK(cell.engine.find_device("wtec") != wtec);
     CHECK(cell.line("line-b").worker->line_up());
-    CHECK(cell.engine.find_unit(3) == cell.engine.find_device("wtec"));
+    CHECK(cell.engine.find_unit(fieldbridge::core::UnitId{3}) == cell.engine.find_device("wtec"));
 }
 
 TEST_CASE("a device's max_age and command_ttl change in place: same agent, same port") {
@@ -173,7 +173,7 @@ TEST_CASE("a device whose profile settings changed is swapped on the open port")
     CHECK(worker_a->scheduler().has_device(swapped->config().index));
     CHECK(worker_a->scheduler().has_device(stepper->config().index));  // the old one drains
     CHECK(cell.engine.find_device("gripper") == gripper);
-    CHECK(cell.engine.find_unit(2) == swapped);
+    CHECK(cell.engine.find_unit(fieldbridge::core::UnitId{2}) == swapped);
     CHECK(cell.line("line-a").retired.size() == 1);
 
     // The next reload that touches the line lets the drained agent go.
@@ -202,8 +202,8 @@ TEST_CASE("devices added and removed on a running line; lines added and removed"
     CHECK(cell.opens["/dev/fb-test-a"] == 1);
     CHECK(cell.opens["/dev/fb-test-c"] == 1);
     CHECK(cell.engine.find_device("stepper") == nullptr);
-    CHECK(cell.engine.find_unit(4) == cell.engine.find_device("gripper-2"));
-    CHECK(cell.engine.find_unit(3) == nullptr);
+    CHECK(cell.engine.find_unit(fieldbridge::core::UnitId{4}) == cell.engine.find_device("gripper-2"));
+    CHECK(cell.engine.find_unit(fieldbridge::core::UnitId{3}) == nullptr);
     CHECK(cell.engine.devices().size() == 3);
     CHECK(cell.line("line-c").worker->line_up());
 }
@@ -219,7 +219,7 @@ TEST_CASE("line policies (retries, offline threshold, broadcast unit) change wit
     CHECK(report.lines_updated == std::vector<std::string>{"line-a"});
     CHECK(cell.line("line-a").worker.get() == worker_a);
     CHECK(cell.line("line-a").revision != revision);
-    CHECK(cell.line("line-a").broadcast_unit == std::uint8_t{100});
+    CHECK(cell.line("line-a").broadcast_unit == fieldbridge::core::UnitId{100});
     CHECK(cell.opens["/dev/fb-test-a"] == 1);
 }
 

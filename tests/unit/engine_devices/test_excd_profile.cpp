@@ -32,7 +32,7 @@ constexpr std::uint16_t solm_plus = 0x0014;
 TEST_CASE("excd: identity, broadcast 0xFF") {
     const Excd e;
     CHECK(e.profile.type() == fe::DeviceType::excd203mb);
-    CHECK(e.profile.broadcast_address() == 0xFF);
+    CHECK(e.profile.broadcast_address() == fieldbridge::core::BusAddress{0xFF});
 }
 
 TEST_CASE("excd: 0x01 for anything but FC03 / FC06 / FC10, and for protected registers") {

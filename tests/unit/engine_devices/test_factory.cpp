@@ -28,7 +28,7 @@ TEST_CASE("factory: every type, with its name, bus and broadcast address") {
         CHECK(p->type() == e.type);
         CHECK(fe::to_string(p->type()) == e.name);
         CHECK(p->bus() == e.bus);
-        CHECK(p->broadcast_address() == e.broadcast);
+        CHECK(p->broadcast_address() == fieldbridge::core::BusAddress{e.broadcast});
         const fe::PollPlan plan = p->poll_plan();
         CHECK_FALSE(plan.items().empty());
     }

@@ -20,7 +20,7 @@ constexpr std::uint32_t stroke = 10000;
 
 fe::ProfileOptions ascii_options(bool allow_protected = false) {
     fe::ProfileOptions o;
-    o.address = 7;
+    o.address = fieldbridge::core::BusAddress{7};
     o.wtec_stroke = stroke;
     o.allow_protected = allow_protected;
     return o;
@@ -153,7 +153,7 @@ TEST_CASE("wtec-ascii: options") {
     const View v;
     CHECK(v.profile.bus() == fe::Bus::wtec_ascii);
     CHECK(v.profile.type() == fe::DeviceType::wtec_ascii);
-    CHECK(v.profile.broadcast_address() == 0);
+    CHECK(v.profile.broadcast_address() == fieldbridge::core::BusAddress{0});
 }
 
 TEST_CASE("wtec-ascii: poll plan") {

@@ -27,7 +27,7 @@ struct Rtu {
 TEST_CASE("wtec-rtu: function codes; FC16 goes out as FC06s") {
     const Rtu w;
     CHECK(w.profile.type() == fe::DeviceType::wtec_rtu);
-    CHECK(w.profile.broadcast_address() == 0);
+    CHECK(w.profile.broadcast_address() == fieldbridge::core::BusAddress{0});
     CHECK(w.check(read_input(0x0200, 1)) == ExceptionCode::illegal_function);
     CHECK(w.check(fp::ReadExceptionStatusRequest{}) == ExceptionCode::illegal_function);
 

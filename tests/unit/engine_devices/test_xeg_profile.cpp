@@ -33,7 +33,7 @@ TEST_CASE("xeg: identity") {
     const Xeg x;
     CHECK(x.profile.type() == fe::DeviceType::hiwin_xeg);
     CHECK(x.profile.bus() == fe::Bus::modbus_rtu);
-    CHECK(x.profile.broadcast_address() == 0);
+    CHECK(x.profile.broadcast_address() == fieldbridge::core::BusAddress{0});
 }
 
 TEST_CASE("xeg: 0x01 for function codes the controller lacks") {

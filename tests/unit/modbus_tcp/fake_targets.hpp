@@ -32,7 +32,7 @@ protected:
 class ImmediateTarget final : public RecordingTarget {
 public:
     explicit ImmediateTarget(asio::io_context& io) : io_(io) {}
-    void handle(std::uint8_t unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
     RegisterBank bank;
 private:
     asio::io_context& io_;
@@ -44,7 +44,7 @@ class DelayedTarget final : public RecordingTarget {
 public:
     /// @p answer_closed: also answer requests whose connection closed (a late answer).
     DelayedTarget(asio::io_context& io, bool answer_closed = false) : io_(io), answer_closed_(answer_closed) {}
-    void handle(std::uint8_t unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
     void client_closed(std::uint64_t connection) override;
     RegisterBank bank;
 private:
@@ -61,7 +61,7 @@ private:
 class SilentTarget final : public RecordingTarget {
 public:
     explicit SilentTarget(asio::io_context& /*io*/) {}
-    void handle(std::uint8_t unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
     void client_closed(std::uint64_t connection) override;
     /// Answers everything held, from the bank; returns how many.
     std::size_t answer_all();
@@ -80,7 +80,7 @@ private:
 class ThrowingTarget final : public RecordingTarget {
 public:
     explicit ThrowingTarget(asio::io_context& /*io*/) {}
-    void handle(std::uint8_t, protocol::ByteView pdu, const ClientRef& client, PduHandler) override {
+    void handle(core::UnitId, protocol::ByteView pdu, const ClientRef& client, PduHandler) override {
         record(pdu, client);
         throw std::runtime_error("fake target failure");
     }
@@ -90,7 +90,7 @@ public:
 class EmptyAnswerTarget final : public RecordingTarget {
 public:
     explicit EmptyAnswerTarget(asio::io_context& io) : io_(io) {}
-    void handle(std::uint8_t unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
 private:
     asio::io_context& io_;
 };

@@ -11,53 +11,54 @@ namespace fieldbridge::northbound::modbus_tcp {
 namespace {
 
 using config::RegisterRange;
+using core::FunctionCode;
 using core::UnitId;
 using protocol::Bytes;
 
 [[nodiscard]] config::IpAddress ip(const char* text) { return *config::parse_ip_address(text); }
 
 TEST_CASE("request_scope reads the address fields of FC01-06, 0F, 10 and both ranges of FC17") {
-    CHECK(request_scope(Bytes{0x01, 0x00, 0x10, 0x00, 0x08}) == RequestScope{0x01, RegisterRange{0x10, 0x17}, {}});
-    CHECK(request_scope(Bytes{0x02, 0x00, 0x00, 0x00, 0x01}) == RequestScope{0x02, RegisterRange{0, 0}, {}});
-    CHECK(request_scope(Bytes{0x03, 0x01, 0x00, 0x00, 0x7D}) == RequestScope{0x03, RegisterRange{0x100, 0x17C}, {}});
-    CHECK(request_scope(Bytes{0x04, 0x03, 0x00, 0x00, 0x02}) == RequestScope{0x04, RegisterRange{0x300, 0x301}, {}});
-    CHECK(request_scope(Bytes{0x05, 0x00, 0x07, 0xFF, 0x00}) == RequestScope{0x05, RegisterRange{7, 7}, {}});
-    CHECK(request_scope(Bytes{0x06, 0x01, 0x02, 0x00, 0x01}) == RequestScope{0x06, RegisterRange{0x102, 0x102}, {}});
+    CHECK(request_scope(Bytes{0x01, 0x00, 0x10, 0x00, 0x08}) == RequestScope{FunctionCode{0x01}, RegisterRange{0x10, 0x17}, {}});
+    CHECK(request_scope(Bytes{0x02, 0x00, 0x00, 0x00, 0x01}) == RequestScope{FunctionCode{0x02}, RegisterRange{0, 0}, {}});
+    CHECK(request_scope(Bytes{0x03, 0x01, 0x00, 0x00, 0x7D}) == RequestScope{FunctionCode{0x03}, RegisterRange{0x100, 0x17C}, {}});
+    CHECK(request_scope(Bytes{0x04, 0x03, 0x00, 0x00, 0x02}) == RequestScope{FunctionCode{0x04}, RegisterRange{0x300, 0x301}, {}});
+    CHECK(request_scope(Bytes{0x05, 0x00, 0x07, 0xFF, 0x00}) == RequestScope{FunctionCode{0x05}, RegisterRange{7, 7}, {}});
+    CHECK(request_scope(Bytes{0x06, 0x01, 0x02, 0x00, 0x01}) == RequestScope{FunctionCode{0x06}, RegisterRange{0x102, 0x102}, {}});
     CHECK(request_scope(Bytes{0x0F, 0x00, 0x13, 0x00, 0x0A, 0x02, 0xCD, 0x01}) ==
-          RequestScope{0x0F, RegisterRange{0x13, 0x1C}, {}});
+          RequestScope{FunctionCode{0x0F}, RegisterRange{0x13, 0x1C}, {}});
     CHECK(request_scope(Bytes{0x10, 0x00, 0x01, 0x00, 0x02, 0x04, 0x00, 0x0A, 0x01, 0x02}) ==
-          RequestScope{0x10, RegisterRange{1, 2}, {}});
+          RequestScope{FunctionCode{0x10}, RegisterRange{1, 2}, {}});
     // FC17 (V1.1b3 section 6.17 example): read 3 from 0x0003, write 3 at 0x000E.
     CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00, 0x03, 0x06, 0, 0xFF, 0, 0xFF, 0, 0xFF}) ==
-          RequestScope{0x17, RegisterRange{3, 8}, RegisterRange{0x0E, 0x10}});
+          RequestScope{FunctionCode{0x17}, RegisterRange{3, 8}, RegisterRange{0x0E, 0x10}});
 }
 
 TEST_CASE("request_scope fails closed: what it cannot derive touches every register") {
     const RegisterRange all{0x0000, 0xFFFF};
     // Only the function codes that read no register and change nothing have no range.
     for (const std::uint8_t function : std::vector<std::uint8_t>{0x07, 0x0B, 0x0C, 0x11}) {
-        CHECK(request_scope(Bytes{function}) == RequestScope{function, {}, {}});
+        CHECK(request_scope(Bytes{function}) == RequestScope{FunctionCode{function}, {}, {}});
     }
     // FC22 (0x16, mask write) is derived: its one register.
     CHECK(request_scope(Bytes{0x16, 0x4E, 0x20, 0xFF, 0xFF, 0x00, 0x01}) ==
-          RequestScope{0x16, RegisterRange{0x4E20, 0x4E20}, {}});
+          RequestScope{FunctionCode{0x16}, RegisterRange{0x4E20, 0x4E20}, {}});
     // Diagnostics, file records, FIFO, encapsulated transport, vendor codes, 0 and >= 0x80.
     for (const std::uint8_t function : std::vector<std::uint8_t>{0x08, 0x14, 0x15, 0x18, 0x2B, 0x41, 0x64, 0x00, 0x85, 0xFF}) {
-        CHECK(request_scope(Bytes{function, 0x0E, 0x01, 0x00}) == RequestScope{function, all, {}});
+        CHECK(request_scope(Bytes{function, 0x0E, 0x01, 0x00}) == RequestScope{FunctionCode{function}, all, {}});
     }
     // Too short to carry the address fields.
-    CHECK(request_scope(Bytes{0x03, 0x00, 0x10, 0x00}) == RequestScope{0x03, all, {}});
-    CHECK(request_scope(Bytes{0x06, 0x00}) == RequestScope{0x06, all, {}});
-    CHECK(request_scope(Bytes{0x16, 0x4E}) == RequestScope{0x16, all, {}});
-    CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00}) == RequestScope{0x17, all, {}});
-    CHECK(request_scope(Bytes{}) == RequestScope{0x00, all, {}});
+    CHECK(request_scope(Bytes{0x03, 0x00, 0x10, 0x00}) == RequestScope{FunctionCode{0x03}, all, {}});
+    CHECK(request_scope(Bytes{0x06, 0x00}) == RequestScope{FunctionCode{0x06}, all, {}});
+    CHECK(request_scope(Bytes{0x16, 0x4E}) == RequestScope{FunctionCode{0x16}, all, {}});
+    CHECK(request_scope(Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00}) == RequestScope{FunctionCode{0x17}, all, {}});
+    CHECK(request_scope(Bytes{}) == RequestScope{FunctionCode{0x00}, all, {}});
 }
 
 TEST_CASE("request_scope: a malformed quantity never shrinks the range") {
     // Quantity 0 still names the addressed register.
-    CHECK(request_scope(Bytes{0x03, 0x00, 0x64, 0x00, 0x00}) == RequestScope{0x03, RegisterRange{100, 100}, {}});
+    CHECK(request_scope(Bytes{0x03, 0x00, 0x64, 0x00, 0x00}) == RequestScope{FunctionCode{0x03}, RegisterRange{100, 100}, {}});
     // Past 0xFFFF: ends at 0xFFFF.
-    CHECK(request_scope(Bytes{0x10, 0xFF, 0xFE, 0x00, 0x7B}) == RequestScope{0x10, RegisterRange{0xFFFE, 0xFFFF}, {}});
+    CHECK(request_scope(Bytes{0x10, 0xFF, 0xFE, 0x00, 0x7B}) == RequestScope{FunctionCode{0x10}, RegisterRange{0xFFFE, 0xFFFF}, {}});
 }
 
 TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges allowed") {
@@ -66,12 +67,13 @@ TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges 
 
     config::AccessRule plc_writes;  // the PLC may write registers 0x100-0x1FF of unit 1
     plc_writes.clients = {test::cidr("10.0.0.5")};
-    plc_writes.units = {1};
-    plc_writes.functions = {0x06, 0x10, 0x17};
+    plc_writes.units = {UnitId{1}};
+    plc_writes.functions = {FunctionCode{0x06}, FunctionCode{0x10}, FunctionCode{0x17}};
     plc_writes.registers = RegisterRange{0x100, 0x1FF};
     plc_writes.action = config::RuleAction::allow;
     config::AccessRule no_other_writes;
-    no_other_writes.functions = {0x05, 0x06, 0x0F, 0x10, 0x17};
+    no_other_writes.functions = {FunctionCode{0x05}, FunctionCode{0x06}, FunctionCode{0x0F}, FunctionCode{0x10},
+                                 FunctionCode{0x17}};
     no_other_writes.action = config::RuleAction::deny;
     config.rules = {plc_writes, no_other_writes};
 
@@ -115,18 +117,18 @@ TEST_CASE("UnitRouter: set, replace, remove, distinct targets") {
     test::ImmediateTarget a(io);
     test::ImmediateTarget b(io);
     UnitRouter router;
-    CHECK(router.find(1) == nullptr);
-    router.set(1, a);
-    router.set(2, a);
-    router.set(200, b);
-    CHECK(router.find(1) == &a);
-    CHECK(router.find(200) == &b);
+    CHECK(router.find(UnitId{1}) == nullptr);
+    router.set(UnitId{1}, a);
+    router.set(UnitId{2}, a);
+    router.set(UnitId{200}, b);
+    CHECK(router.find(UnitId{1}) == &a);
+    CHECK(router.find(UnitId{200}) == &b);
     CHECK(router.size() == 3);
     CHECK(router.targets() == std::vector<UnitTarget*>{&a, &b});
-    router.set(2, b);
-    CHECK(router.find(2) == &b);
-    router.remove(1);
-    CHECK(router.find(1) == nullptr);
+    router.set(UnitId{2}, b);
+    CHECK(router.find(UnitId{2}) == &b);
+    router.remove(UnitId{1});
+    CHECK(router.find(UnitId{1}) == nullptr);
     CHECK(router.targets() == std::vector<UnitTarget*>{&b});
     router.clear();
     CHECK(router.size() == 0);

@@ -15,17 +15,17 @@ namespace {
     auto config = loopback_config();
     config::AccessRule protect;
     protect.clients = {cidr("127.0.0.0/8")};
-    protect.units = {1};
-    protect.functions = {0x06, 0x10, 0x17};
+    protect.units = {core::UnitId{1}};
+    protect.functions = {core::FunctionCode{0x06}, core::FunctionCode{0x10}, core::FunctionCode{0x17}};
     protect.registers = config::RegisterRange{100, 199};
     protect.action = config::RuleAction::deny;
     config::AccessRule window;
-    window.units = {2};
-    window.functions = {0x03};
+    window.units = {core::UnitId{2}};
+    window.functions = {core::FunctionCode{0x03}};
     window.registers = config::RegisterRange{0, 9};
     window.action = config::RuleAction::allow;
     config::AccessRule rest_of_unit2;
-    rest_of_unit2.units = {2};
+    rest_of_unit2.units = {core::UnitId{2}};
     rest_of_unit2.action = config::RuleAction::deny;
     config.rules = {protect, window, rest_of_unit2};
     return config;
@@ -44,7 +44,7 @@ TEST_CASE("access rules: denied requests get exception 0x01 and the target never
     auto response = client.ask(write_register(1, 1, 150, 7));
     REQUIRE(response);
     CHECK(response->transaction_id == 1);
-    CHECK(response->unit_id == 1);
+    CHECK(response->unit_id == core::UnitId{1});
     CHECK(response->pdu == exception_pdu(0x06, 0x01));
     CHECK(seen(0) == 0);
 
@@ -71,7 +71,7 @@ TEST_CASE("access rules: denied requests get exception 0x01 and the target never
     response = client.ask(read_registers(7, 2, 0, 1, 0x04));  // another function
     REQUIRE(response);
     CHECK(response->pdu == exception_pdu(0x04, 0x01));
-    response = client.ask(protocol::encode_mbap(8, 2, Bytes{0x07}));  // FC07: no registers, denied by rule 3
+    response = client.ask(protocol::encode_mbap(8, core::UnitId{2}, Bytes{0x07}));  // FC07: no registers, denied by rule 3
     REQUIRE(response);
     CHECK(response->pdu == exception_pdu(0x07, 0x01));
     CHECK(seen(1) == 1);

@@ -21,7 +21,7 @@ TEST_CASE("a request is answered with its transaction ID and unit") {
     const auto response = client.ask(read_registers(0xBEEF, 5, 0x0300, 2));
     REQUIRE(response);
     CHECK(response->transaction_id == 0xBEEF);
-    CHECK(response->unit_id == 5);
+    CHECK(response->unit_id == core::UnitId{5});
     CHECK(response->pdu == bank_read(0x0300, 2));
     const auto stats = h.stats();
     CHECK(stats.requests == 1);
@@ -47,12 +47,12 @@ TEST_CASE("pipelined requests are answered in completion order, each with its ow
         answers.push_back(*frame);
     }
     CHECK(answers[0].transaction_id == 11);
-    CHECK(answers[0].unit_id == 2);
+    CHECK(answers[0].unit_id == core::UnitId{2});
     CHECK(answers[0].pdu == bank_read(0, 2));
     CHECK(answers[1].transaction_id == 12);
     CHECK(answers[1].pdu == bank_read(100, 1));
     CHECK(answers[2].transaction_id == 10);
-    CHECK(answers[2].unit_id == 1);
+    CHECK(answers[2].unit_id == core::UnitId{1});
     CHECK(answers[2].pdu == bank_read(300, 3));
 }
 
@@ -73,7 +73,7 @@ TEST_CASE("a unit without a route gets exception 0x0A and reaches no target") {
     const auto response = client.ask(read_registers(3, 9, 0, 1, 0x04));
     REQUIRE(response);
     CHECK(response->transaction_id == 3);
-    CHECK(response->unit_id == 9);
+    CHECK(response->unit_id == core::UnitId{9});
     CHECK(response->pdu == exception_pdu(0x04, 0x0A));
     const auto stats = h.stats();
     CHECK(stats.unknown_unit == 1);
@@ -85,7 +85,7 @@ TEST_CASE("a PDU the target cannot decode is forwarded as it came; its exception
     Harness h(loopback_config(), {}, [](Harness& self) { self.add_target<ImmediateTarget>({1}); });
     Client client(h.port);
     const Bytes bad_count{0x03, 0x00, 0x00, 0x00, 0x00};  // quantity 0
-    const auto response = client.ask(protocol::encode_mbap(8, 1, bad_count));
+    const auto response = client.ask(protocol::encode_mbap(8, core::UnitId{1}, bad_count));
     REQUIRE(response);
     CHECK(response->pdu == exception_pdu(0x03, 0x03));
     CHECK(h.on_loop([&] { return dynamic_cast<ImmediateTarget&>(*h.targets[0]).seen; }) == std::vector<Bytes>{bad_count});

@@ -159,19 +159,19 @@ std::optional<protocol::MbapFrame> Client::ask(ByteView request) {
 
 Bytes read_registers(std::uint16_t transaction, std::uint8_t unit, std::uint16_t address, std::uint16_t count,
                      std::uint8_t function) {
-    return protocol::encode_mbap(transaction, unit,
+    return protocol::encode_mbap(transaction, core::UnitId{unit},
                                  protocol::encode_request(protocol::ReadRegistersRequest{function, address, count}));
 }
 
 Bytes write_register(std::uint16_t transaction, std::uint8_t unit, std::uint16_t address, std::uint16_t value) {
-    return protocol::encode_mbap(transaction, unit,
+    return protocol::encode_mbap(transaction, core::UnitId{unit},
                                  protocol::encode_request(protocol::WriteSingleRegisterRequest{address, value}));
 }
 
 Bytes read_write_registers(std::uint16_t transaction, std::uint8_t unit, std::uint16_t read_address,
                            std::uint16_t read_count, std::uint16_t write_address, std::uint16_t write_value) {
     return protocol::encode_mbap(
-        transaction, unit,
+        transaction, core::UnitId{unit},
         protocol::encode_request(protocol::ReadWriteRegistersRequest{read_address, read_count, write_address, {write_value}}));
 }
 

@@ -48,7 +48,7 @@ public:
     Target& add_target(std::vector<std::uint8_t> units, Args&&... args) {
         auto target = std::make_unique<Target>(io, std::forward<Args>(args)...);
         Target& ref = *target;
-        for (auto unit : units) server->routes().set(unit, ref);
+        for (auto unit : units) server->routes().set(core::UnitId{unit}, ref);
         targets.push_back(std::move(target));
         return ref;
     }

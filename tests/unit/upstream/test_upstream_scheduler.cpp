@@ -47,7 +47,7 @@ struct Fixture {
         UpstreamRequest r;
         r.client = client;
         r.poll = poll;
-        r.unit = 1;
+        r.unit = core::UnitId{1};
         r.pdu = pdu;
         const Classified c = classify(pdu);
         REQUIRE(c.request);
@@ -109,11 +109,11 @@ TEST_CASE("window: one outstanding by default; transaction IDs are unique and ma
     CHECK(a->transaction_id != b->transaction_id);
     CHECK(b->transaction_id != c->transaction_id);
     // Answers out of order reach their own requests; a wrong unit or unknown ID is dropped.
-    CHECK_FALSE(f.s->reply(b->transaction_id, 7, {0x03, 0x02, 0x00, 0x02}, f.t0));
-    CHECK(f.s->reply(c->transaction_id, 1, {0x03, 0x02, 0x00, 0x03}, f.t0));
-    CHECK(f.s->reply(a->transaction_id, 1, {0x03, 0x02, 0x00, 0x01}, f.t0));
-    CHECK(f.s->reply(b->transaction_id, 1, {0x03, 0x02, 0x00, 0x02}, f.t0));
-    CHECK_FALSE(f.s->reply(b->transaction_id, 1, {0x03, 0x02, 0x00, 0x02}, f.t0));
+    CHECK_FALSE(f.s->reply(b->transaction_id, core::UnitId{7}, {0x03, 0x02, 0x00, 0x02}, f.t0));
+    CHECK(f.s->reply(c->transaction_id, core::UnitId{1}, {0x03, 0x02, 0x00, 0x03}, f.t0));
+    CHECK(f.s->reply(a->transaction_id, core::UnitId{1}, {0x03, 0x02, 0x00, 0x01}, f.t0));
+    CHECK(f.s->reply(b->transaction_id, core::UnitId{1}, {0x03, 0x02, 0x00, 0x02}, f.t0));
+    CHECK_FALSE(f.s->reply(b->transaction_id, core::UnitId{1}, {0x03, 0x02, 0x00, 0x02}, f.t0));
     f.drain();
     REQUIRE(f.log.done.size() == 3);
     CHECK(f.log.done[0].first == "r2");
@@ -152,12 +152,12 @@ TEST_CASE("timeouts, command TTL, queue limit, wrong function, connection loss")
     CHECK(f.log.done[2].second.status == UpstreamStatus::expired);
     CHECK(f.s->consecutive_timeouts() == 1);
     // The late reply finds nobody.
-    CHECK_FALSE(f.s->reply(d->transaction_id, 1, {0x03, 0x02, 0x00, 0x01}, f.t0));
+    CHECK_FALSE(f.s->reply(d->transaction_id, core::UnitId{1}, {0x03, 0x02, 0x00, 0x01}, f.t0));
 
     // A reply with another function code fails the request (0x0B).
     auto r2 = f.s->next(f.t0 + st.response_timeout);
     REQUIRE(r2);
-    CHECK(f.s->reply(r2->transaction_id, 1, {0x04, 0x02, 0x00, 0x01}, f.t0));
+    CHECK(f.s->reply(r2->transaction_id, core::UnitId{1}, {0x04, 0x02, 0x00, 0x01}, f.t0));
     f.drain();
     CHECK(f.log.done.back().first == "read2");
     CHECK(f.log.done.back().second.status == UpstreamStatus::timeout);
@@ -211,7 +211,7 @@ TEST_CASE("sequences end on refusal, lapse when idle, and end when the client cl
     auto d = f.s->next(f.t0);
     REQUIRE(d);
     CHECK(f.s->owner(Resource::counter_read) == std::optional<std::uint64_t>{1});
-    f.s->reply(d->transaction_id, 1, {0x90, 0x02}, f.t0);  // refused: nothing selected
+    f.s->reply(d->transaction_id, core::UnitId{1}, {0x90, 0x02}, f.t0);  // refused: nothing selected
     CHECK_FALSE(f.s->owner(Resource::counter_read));
 
     f.submit("A select again", 1, counter_select_1, f.t0);
@@ -238,7 +238,7 @@ TEST_CASE("sequences end on refusal, lapse when idle, and end when the client cl
     CHECK(in_flight->pdu == counter_read);
     f.s->client_closed(3);
     CHECK_FALSE(f.s->owner(Resource::counter_read));
-    CHECK(f.s->reply(in_flight->transaction_id, 1, {0x03, 0x0C, 0, 0, 0, 1, 0, 0, 0, 0x0A, 0, 0, 0, 5}, f.t0));
+    CHECK(f.s->reply(in_flight->transaction_id, core::UnitId{1}, {0x03, 0x0C, 0, 0, 0, 1, 0, 0, 0, 0x0A, 0, 0, 0, 5}, f.t0));
     CHECK(f.send_and_answer(f.t0) == counter_read);  // D
     f.drain();
     CHECK(f.log.done.size() == answered + 2);  // C select and D read; nothing more for C
@@ -314,7 +314,7 @@ TEST_CASE("a hold past sequence_max_hold ends when the owner's request in flight
     CHECK(*deadline == f->t0 + milliseconds{90} + st.response_timeout);
     f->s->tick(f->t0 + milliseconds{150});
     CHECK(f->s->owner(Resource::counter_read) == std::optional<std::uint64_t>{1});
-    CHECK(f->s->reply(in_flight->transaction_id, 1, Bytes(counter_select_1.begin(), counter_select_1.begin() + 5),
+    CHECK(f->s->reply(in_flight->transaction_id, core::UnitId{1}, Bytes(counter_select_1.begin(), counter_select_1.begin() + 5),
                      f->t0 + milliseconds{160}));
     CHECK_FALSE(f->s->owner(Resource::counter_read));
     CHECK(f->send_and_answer(f->t0 + milliseconds{160}) == counter_read);

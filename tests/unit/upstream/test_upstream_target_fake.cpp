@@ -26,9 +26,9 @@ TEST_CASE("no reply within response_timeout: 0x0B; an expired command is never s
     target.start();
     REQUIRE(run_until(io, [&] { return target.link_state() == LinkState::up; }));
     auto read = std::make_shared<Answer>();
-    target.handle(10, mode_read, client(1), capture(read));
+    target.handle(core::UnitId{10}, mode_read, client(1), capture(read));
     auto command = std::make_shared<Answer>();
-    target.handle(10, hex("06 4E E8 00 64"), client(2), capture(command));
+    target.handle(core::UnitId{10}, hex("06 4E E8 00 64"), client(2), capture(command));
     CHECK_FALSE(read->done);  // never answered from inside handle()
     REQUIRE(run_until(io, [&] { return read->done && command->done; }, milliseconds{5000}));
     // The command waited behind the poll / read window past its 100 ms TTL.
@@ -70,7 +70,7 @@ TEST_CASE("pipelined requests get their own answers: upstream transaction IDs re
         std::vector<std::shared_ptr<Answer>> answers;
         for (std::uint8_t i = 0; i < 3; ++i) {
             answers.push_back(std::make_shared<Answer>());
-            target.handle(10, Bytes{0x03, 0x01, static_cast<std::uint8_t>(0x10 + i), 0x00, 0x01},
+            target.handle(core::UnitId{10}, Bytes{0x03, 0x01, static_cast<std::uint8_t>(0x10 + i), 0x00, 0x01},
                           client(static_cast<std::uint64_t>(i % 2 + 1)), capture(answers.back()));
         }
         REQUIRE(run_until(io, [&] {
@@ -92,12 +92,12 @@ TEST_CASE("answered locally: unknown unit, not started, malformed PDU, upstream 
     auto cfg = config_for(closed_port);
     UpstreamTarget target(io, cfg, CapturedLog{}.sink());
     auto not_started = std::make_shared<Answer>();
-    target.handle(10, mode_read, client(1), capture(not_started));
+    target.handle(core::UnitId{10}, mode_read, client(1), capture(not_started));
     target.start();
     auto unknown = std::make_shared<Answer>();
-    target.handle(11, mode_read, client(1), capture(unknown));
+    target.handle(core::UnitId{11}, mode_read, client(1), capture(unknown));
     auto malformed = std::make_shared<Answer>();
-    target.handle(10, hex("10 08 83 00 02 04 00"), client(1), capture(malformed));
+    target.handle(core::UnitId{10}, hex("10 08 83 00 02 04 00"), client(1), capture(malformed));
     REQUIRE(run_until(io, [&] { return not_started->done && unknown->done && malformed->done; }));
     CHECK(not_started->pdu == hex("83 0A"));
     CHECK(unknown->pdu == hex("83 0A"));
@@ -105,12 +105,12 @@ TEST_CASE("answered locally: unknown unit, not started, malformed PDU, upstream 
     // Nobody listens: the link backs off and requests are refused at once, 0x0A.
     REQUIRE(run_until(io, [&] { return target.link_state() == LinkState::backoff; }));
     auto down = std::make_shared<Answer>();
-    target.handle(10, mode_read, client(1), capture(down));
+    target.handle(core::UnitId{10}, mode_read, client(1), capture(down));
     REQUIRE(run_until(io, [&] { return down->done; }));
     CHECK(down->pdu == hex("83 0A"));
-    REQUIRE(target.state(10));
-    CHECK_FALSE(target.state(10)->online);
-    CHECK_FALSE(target.state(11));
+    REQUIRE(target.state(core::UnitId{10}));
+    CHECK_FALSE(target.state(core::UnitId{10})->online);
+    CHECK_FALSE(target.state(core::UnitId{11}));
 }
 
 TEST_CASE("consecutive timeouts re-establish the connection") {
@@ -140,7 +140,7 @@ TEST_CASE("destroyed with requests outstanding: every handler answered once, not
         REQUIRE(run_until(io, [&] { return target->link_state() == LinkState::up; }));
         for (int i = 0; i < 5; ++i) {
             answers.push_back(std::make_shared<Answer>());
-            target->handle(10, mode_read, client(1), capture(answers.back()));
+            target->handle(core::UnitId{10}, mode_read, client(1), capture(answers.back()));
         }
         run_for(io, milliseconds{20});  // two in flight, the rest queued
         target->set_state_callback([&state_reports_after](const R6State&) { ++state_reports_after; });
@@ -158,7 +158,7 @@ TEST_CASE("destroyed with requests outstanding: every handler answered once, not
         auto target = std::make_unique<UpstreamTarget>(io, config_for(silent.port()), CapturedLog{}.sink());
         target->start();
         auto a = std::make_shared<Answer>();
-        target->handle(10, mode_read, client(1), capture(a));
+        target->handle(core::UnitId{10}, mode_read, client(1), capture(a));
         target.reset();
         REQUIRE(run_until(io, [&] { return a->done; }));
         CHECK(a->pdu == hex("83 0A"));
@@ -200,7 +200,7 @@ TEST_CASE("a reply that does not fit its request is answered 0x04, counted and l
     for (const char* request : {"03 01 00 00 01", "03 01 00 00 02", "03 01 00 00 03", "03 01 00 00 04",
                                 "06 4E E8 00 64"}) {
         answers.push_back(std::make_shared<Answer>());
-        target.handle(10, hex(request), client(1), capture(answers.back()));
+        target.handle(core::UnitId{10}, hex(request), client(1), capture(answers.back()));
     }
     REQUIRE(run_until(io, [&] {
         return std::all_of(answers.begin(), answers.end(), [](const auto& a) { return a->done; });

@@ -50,7 +50,7 @@ fieldbridge::config::UpstreamConfig config_for(std::uint16_t port) {
     c.poll_period = milliseconds{100};
     c.command_ttl = milliseconds{2000};
     c.queue_limit = 64;
-    c.units = {{10, 1, "robot"}};
+    c.units = {{fieldbridge::core::UnitId{10}, fieldbridge::core::UnitId{1}, "robot"}};
     return c;
 }
 
@@ -137,7 +137,7 @@ void FakeUpstream::read() {
             auto frame = fieldbridge::protocol::decode_mbap(received_);
             if (!frame.complete()) break;
             received_.erase(received_.begin(), received_.begin() + static_cast<std::ptrdiff_t>(frame.consumed));
-            Request r{frame.value.transaction_id, frame.value.unit_id, frame.value.pdu};
+            Request r{frame.value.transaction_id, frame.value.unit_id.value, frame.value.pdu};
             requests_.push_back(r);
             on_request_(*this, r);
             if (!*alive) return;
@@ -148,7 +148,7 @@ void FakeUpstream::read() {
 
 void FakeUpstream::send(std::uint16_t transaction_id, std::uint8_t unit, const Bytes& pdu) {
     if (!socket_) return;
-    auto frame = std::make_shared<Bytes>(fieldbridge::protocol::encode_mbap(transaction_id, unit, pdu));
+    auto frame = std::make_shared<Bytes>(fieldbridge::protocol::encode_mbap(transaction_id, fieldbridge::core::UnitId{unit}, pdu));
     asio::async_write(*socket_, asio::buffer(*frame), [frame](const asio::error_code&, std::size_t) {});
 }
 
