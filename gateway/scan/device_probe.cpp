@@ -5,7 +5,9 @@
 #include <utility>
 #include <variant>
 
+#include "engine/profiles/excd_profile.hpp"
 #include "engine/profiles/profile_text.hpp"
+#include "engine/profiles/wtec_rtu_profile.hpp"
 #include "engine/profiles/xeg_profile.hpp"
 #include "protocol/wtec_ascii_commands.hpp"
 #include "protocol/wtec_ascii_frame.hpp"
@@ -14,13 +16,19 @@ namespace fieldbridge::scan {
 
 namespace {
 
-constexpr std::uint16_t presence_register = 0x0000;
-constexpr std::uint16_t xeg_model_register = 0x0600;    // seed 001 section 3.3 "EG type"
-constexpr std::uint16_t wtec_id_register = 0x0303;      // seed 003 table 2.11 "设备ID"
-constexpr std::uint16_t excd_version_register = 0x0207;  // seed 002 section 4 "ver", two registers
+/// Any Modbus device: the first holding register. Which registers tell the device
+/// types apart is their profiles' knowledge (`*_identification()`).
+constexpr engine::IdentificationRead presence{0, 1};
 
-[[nodiscard]] protocol::Request read_holding(std::uint16_t address, std::uint16_t count) {
-    return protocol::ReadRegistersRequest{protocol::fc::read_holding_registers, address, count};
+[[nodiscard]] protocol::Request read_holding(engine::IdentificationRead read) {
+    return protocol::ReadRegistersRequest{protocol::fc::read_holding_registers, read.address, read.count};
+}
+
+/// The register, or the first and last ones ("A-B") for a read of several.
+[[nodiscard]] std::string span_text(engine::IdentificationRead read) {
+    std::string text = engine::hex_word(read.address);
+    if (read.count > 1) text += "-" + engine::hex_word(static_cast<std::uint16_t>(read.address + read.count - 1));
+    return text;
 }
 
 /// The values of a register read reply; nullopt for an exception or nothing.
@@ -41,10 +49,10 @@ ModbusProbe::ModbusProbe(std::uint8_t address) : address_(address) {}
 
 std::optional<protocol::Request> ModbusProbe::next() const {
     switch (step_) {
-        case Step::presence: return read_holding(presence_register, 1);
-        case Step::xeg_model: return read_holding(xeg_model_register, 1);
-        case Step::wtec_id: return read_holding(wtec_id_register, 1);
-        case Step::excd_version: return read_holding(excd_version_register, 2);
+        case Step::presence: return read_holding(presence);
+        case Step::xeg_model: return read_holding(engine::xeg_identification());
+        case Step::wtec_id: return read_holding(engine::wtec_rtu_identification());
+        case Step::excd_version: return read_holding(engine::excd_identification());
         case Step::finished: break;
     }
     return std::nullopt;
@@ -78,7 +86,8 @@ void ModbusProbe::on_reply(const std::optional<protocol::Response>& reply) {
             return;
         case Step::wtec_id:
             if (values && values->size() == 1 && values->front() == address_) {
-                identified(engine::DeviceType::wtec_rtu, "device ID register 0x0303 reads " + std::to_string(address_));
+                identified(engine::DeviceType::wtec_rtu, "device ID register " + span_text(engine::wtec_rtu_identification()) +
+                                                             " reads " + std::to_string(address_));
                 return;
             }
             step_ = Step::excd_version;
@@ -86,13 +95,13 @@ void ModbusProbe::on_reply(const std::optional<protocol::Response>& reply) {
         case Step::excd_version:
             if (values && values->size() == 2) {
                 const std::uint32_t version = (std::uint32_t{(*values)[0]} << 16) | (*values)[1];
-                identified(engine::DeviceType::excd203mb, "ver (0x0207-0x0208) reads " + std::to_string(version));
+                identified(engine::DeviceType::excd203mb,
+                           "ver (" + span_text(engine::excd_identification()) + ") reads " + std::to_string(version));
                 return;
             }
             identified(engine::DeviceType::modbus,
-                       holding_zero_readable_
-                           ? "answers FC03 at 0x0000; not an XEG, WTEC-485 or EXCD203MB"
-                           : "answers FC03 at 0x0000 with an exception; not an XEG, WTEC-485 or EXCD203MB");
+                       "answers FC03 at " + span_text(presence) + (holding_zero_readable_ ? "" : " with an exception") +
+                           "; not an XEG, WTEC-485 or EXCD203MB");
             return;
         case Step::finished: break;
     }

@@ -5,15 +5,17 @@
 /// through the line master).
 ///
 /// Modbus-RTU, per address (ModbusProbe):
-///  1. presence: FC03, one holding register at 0x0000. Any valid reply, an exception
+///  1. presence: FC03, the first holding register. Any valid reply, an exception
 ///     included, means a device listens at that address; no reply ends the probe.
-///  2. HIWIN XEG: FC03 0x0600 (the gripper model, seed 001 section 3.3) reads one of
-///     the listed model codes (0x0A10 XEG-16 ... 0x0A40 XEG-64).
-///  3. WTEC-485 in RTU mode: FC03 0x0303 (device ID, seed 003 table 2.11) reads the
-///     address the device answered from.
-///  4. EXCD203MB: FC03 0x0207-0x0208 (`ver`, a 32-bit query register of seed 002
-///     section 4) is answered with two registers.
+///  2. HIWIN XEG: FC03 of the model register (engine::xeg_identification()) reads one
+///     of the model codes the XEG profile knows (engine::xeg_model_limits()).
+///  3. WTEC-485 in RTU mode: FC03 of the device ID register
+///     (engine::wtec_rtu_identification()) reads the address the device answered from.
+///  4. EXCD203MB: FC03 of `ver` (engine::excd_identification(), a 32-bit query
+///     register) is answered with two registers.
 ///  5. anything else is a generic Modbus device.
+/// The registers are the profiles' (docs/architecture.md, "Device knowledge"); the
+/// probe holds none.
 /// Every request is a read: nothing a scan sends can move or reconfigure a device.
 ///
 /// WTEC-485 ASCII: `$` (read all stations, seed 003 command 2) goes to address 00
@@ -35,10 +37,10 @@ namespace fieldbridge::scan {
 struct FoundDevice {
     std::uint8_t address = 0;
     engine::DeviceType type = engine::DeviceType::modbus;
-    /// What identified it, for the snippet's comment: "XEG-32 (model 0x0A20)".
+    /// What identified it, for the snippet's comment: "XEG-32 (model <model code>)".
     std::string detail;
-    /// modbus only: holding register 0x0000 answered with a value (so a block there
-    /// is known to be readable).
+    /// modbus only: the first holding register answered with a value (so a block
+    /// there is known to be readable).
     bool holding_zero_readable = false;
     bool operator==(const FoundDevice&) const = default;
 };

@@ -34,7 +34,7 @@ struct ScanResult {
 
 class LineScanner {
 public:
-    /// One line of progress text ("address 2: hiwin-xeg, XEG-32 (model 0x0A20)").
+    /// One line of progress text ("address 2: hiwin-xeg, XEG-32 (model <model code>)").
     using Progress = std::function<void(const std::string&)>;
 
     LineScanner(LineLink& link, ScanRange range, Progress progress = {});

@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
     config::ModbusTcpConfig config;
     config.listen = {config::ListenAddress{"127.0.0.1", 0}};
     config.max_connections = clients + 1;
+    config.max_connections_per_client = clients + 1;  // every client is 127.0.0.1
     northbound::modbus_tcp::ModbusTcpServer server(io, std::make_shared<const config::ModbusTcpConfig>(config), {});
     CachedTarget target(io, registers);
     server.routes().set(core::UnitId{1}, target);

@@ -315,6 +315,9 @@ gateway: {{ id: bench, log_level: info }}
 modbus_tcp:
   listen: ["127.0.0.1:{}"]
   max_connections: 64
+  # Every benchmark client connects from 127.0.0.1: the per-address cap (default 16,
+  # docs/modbus-tcp.md) would refuse the 17th.
+  max_connections_per_client: 64
 metrics_http:
   listen: 127.0.0.1:{}
 lines:

@@ -54,6 +54,13 @@ struct GenericBlock {
     bool writable = false;    ///< coils and holding only
 };
 
+/// A read of holding registers (FC03) that tells a device type apart from the others
+/// on a bus scan (`fieldbridge scan`): the profile names it, the scan only sends it.
+struct IdentificationRead {
+    std::uint16_t address = 0;
+    std::uint16_t count = 1;
+};
+
 /// Everything a profile takes from the configuration (mapped by the glue layer).
 struct ProfileOptions {
     core::BusAddress address{1};  ///< the WTEC ASCII view shows it at 0x0303

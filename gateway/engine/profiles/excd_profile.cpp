@@ -207,6 +207,8 @@ constexpr std::uint16_t ralarm = 0x02D6;
 
 }  // namespace
 
+IdentificationRead excd_identification() noexcept { return IdentificationRead{ver, 2}; }
+
 OperationSet excd_operations() { return OperationSet{"excd", excd_operation_table()}; }
 
 ExcdProfile::ExcdProfile(const ProfileOptions& options)

@@ -21,6 +21,10 @@ namespace fieldbridge::engine {
 /// jog_stop (seed 002 "運轉指令"). 32-bit values high word first.
 [[nodiscard]] OperationSet excd_operations();
 
+/// The scan's read of `ver` (seed 002 section 4, a 32-bit query register): an
+/// EXCD203MB answers it with two registers.
+[[nodiscard]] IdentificationRead excd_identification() noexcept;
+
 class ExcdProfile final : public ModbusProfile {
 public:
     explicit ExcdProfile(const ProfileOptions& options);

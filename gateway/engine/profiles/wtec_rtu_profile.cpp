@@ -17,6 +17,8 @@ namespace {
 
 }  // namespace
 
+IdentificationRead wtec_rtu_identification() noexcept { return IdentificationRead{wtec_reg::device_id, 1}; }
+
 WtecRtuProfile::WtecRtuProfile(const ProfileOptions& options)
     : ModbusProfile(std::make_shared<const RegisterMap>(wtec_uniform_defs(false)), wtec_rtu_wire_functions(), options,
                     WordOrder::high_first) {}

@@ -12,6 +12,10 @@
 
 namespace fieldbridge::engine {
 
+/// The scan's read of the device ID register (seed 003 table 2.11 "设备ID"): a WTEC-485
+/// in RTU mode answers the address it answered from.
+[[nodiscard]] IdentificationRead wtec_rtu_identification() noexcept;
+
 class WtecRtuProfile final : public ModbusProfile {
 public:
     explicit WtecRtuProfile(const ProfileOptions& options);

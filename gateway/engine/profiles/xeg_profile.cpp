@@ -168,6 +168,8 @@ std::optional<XegModelLimits> xeg_model_limits(std::uint16_t value) noexcept {
     return std::nullopt;
 }
 
+IdentificationRead xeg_identification() noexcept { return IdentificationRead{model, 1}; }
+
 XegModelLimits xeg_widest_limits() noexcept {
     return XegModelLimits{0, "unknown", 6400, 10000, 2000, 40};
 }

@@ -37,6 +37,10 @@ struct XegModelLimits {
 /// stroke and speeds with the lowest force minimum (40 %).
 [[nodiscard]] XegModelLimits xeg_widest_limits() noexcept;
 
+/// The scan's read of the model register (seed 001 §3.3 "EG type"): an XEG answers one
+/// of the model codes xeg_model_limits() knows.
+[[nodiscard]] IdentificationRead xeg_identification() noexcept;
+
 /// Seed 001 §4.2.4: the text of an FC07 exception status code.
 [[nodiscard]] std::string_view xeg_exception_status_text(std::uint8_t code) noexcept;
 

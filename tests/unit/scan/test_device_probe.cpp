@@ -77,6 +77,7 @@ TEST_CASE("a WTEC-485 in RTU mode: 0x0303 reads its own address") {
     CHECK(sent[2] == ReadRegistersRequest{fc::read_holding_registers, 0x0303, 1});
     REQUIRE(probe.result().has_value());
     CHECK(probe.result()->type == engine::DeviceType::wtec_rtu);
+    CHECK(probe.result()->detail == "device ID register 0x0303 reads 9");
 }
 
 TEST_CASE("0x0303 reading another number is not a WTEC; two registers at 0x0207 are an EXCD203MB") {
@@ -95,6 +96,17 @@ TEST_CASE("a device that stops answering after the presence read is a generic Mo
     REQUIRE(probe.result().has_value());
     CHECK(probe.result()->type == engine::DeviceType::modbus);
     CHECK_FALSE(probe.result()->holding_zero_readable);
+    CHECK(probe.result()->detail == "answers FC03 at 0x0000 with an exception; not an XEG, WTEC-485 or EXCD203MB");
+}
+
+TEST_CASE("a generic Modbus device whose first holding register reads a value") {
+    ModbusProbe probe(41);
+    const auto sent = run(probe, {values({7}), std::nullopt, std::nullopt, std::nullopt});
+    CHECK(sent[0] == ReadRegistersRequest{fc::read_holding_registers, 0x0000, 1});
+    REQUIRE(probe.result().has_value());
+    CHECK(probe.result()->type == engine::DeviceType::modbus);
+    CHECK(probe.result()->holding_zero_readable);
+    CHECK(probe.result()->detail == "answers FC03 at 0x0000; not an XEG, WTEC-485 or EXCD203MB");
 }
 
 TEST_CASE("on_reply after the probe finished is a caller error") {
