@@ -4,6 +4,8 @@
 #include <variant>
 #include <vector>
 
+#include "engine/profiles/register_map.hpp"
+
 namespace fieldbridge::engine {
 
 using protocol::ExceptionCode;
@@ -27,11 +29,11 @@ protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept {
 ExceptionCode exception_for(OutcomeStatus status) noexcept { return protocol::exception_code(refusal_for(status)); }
 
 protocol::Response exception_response(const protocol::Request& request, ExceptionCode code) {
-    return protocol::exception_response(protocol::function_of(request), code);
+    return protocol::exception_response(protocol::function_code(request), code);
 }
 
 protocol::Response exception_response(const protocol::Request& request, protocol::GatewayRefusal refusal) {
-    return protocol::exception_response(protocol::function_of(request), refusal);
+    return protocol::exception_response(protocol::function_code(request), refusal);
 }
 
 std::optional<protocol::Response> answer_from_image(const protocol::Request& request, const RegisterImage& image,
@@ -43,14 +45,14 @@ std::optional<protocol::Response> answer_from_image(const protocol::Request& req
         [&](const auto& r) -> std::optional<protocol::Response> {
             using T = std::decay_t<decltype(r)>;
             if constexpr (std::is_same_v<T, protocol::ReadRegistersRequest>) {
-                const Table table = r.function == protocol::fc::read_input_registers ? Table::input : Table::holding;
+                const Table table = table_of_read(protocol::function_code(r));
                 auto values = image.read_fresh(table, r.address, r.count, now, max_age);
                 if (!values) {
                     return std::nullopt;
                 }
                 return protocol::ReadRegistersResponse{r.function, std::move(*values)};
             } else if constexpr (std::is_same_v<T, protocol::ReadBitsRequest>) {
-                const Table table = r.function == protocol::fc::read_coils ? Table::coils : Table::discrete_inputs;
+                const Table table = table_of_read(protocol::function_code(r));
                 const auto values = image.read_fresh(table, r.address, r.count, now, max_age);
                 if (!values) {
                     return std::nullopt;

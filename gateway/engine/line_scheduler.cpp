@@ -21,7 +21,7 @@ std::size_t class_index(Priority priority) noexcept { return static_cast<std::si
 bool may_retry(const Transaction& transaction) noexcept {
     if (!transaction.retry_allowed) return false;
     if (const auto* modbus = std::get_if<ModbusPayload>(&transaction.payload)) {
-        return !protocol::is_write(protocol::function_of(modbus->request));
+        return !protocol::is_write(protocol::function_code(modbus->request));
     }
     return true;
 }
@@ -29,7 +29,7 @@ bool may_retry(const Transaction& transaction) noexcept {
 /// For the log: a request that may have changed the device.
 bool may_write(const Transaction& transaction) noexcept {
     if (const auto* modbus = std::get_if<ModbusPayload>(&transaction.payload)) {
-        return protocol::is_write(protocol::function_of(modbus->request));
+        return protocol::is_write(protocol::function_code(modbus->request));
     }
     return !transaction.retry_allowed;
 }

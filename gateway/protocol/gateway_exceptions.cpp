@@ -22,21 +22,21 @@ ExceptionCode exception_code(GatewayRefusal refusal) noexcept {
     return ExceptionCode::server_device_failure;
 }
 
-Bytes exception_pdu(std::uint8_t function, ExceptionCode code) {
+Bytes exception_pdu(core::FunctionCode function, ExceptionCode code) {
     // Section 7: the function byte with its high bit set, then the code.
-    return {static_cast<std::uint8_t>(function | fc::exception_flag), static_cast<std::uint8_t>(code)};
+    return {static_cast<std::uint8_t>(function.value | fc::exception_flag), static_cast<std::uint8_t>(code)};
 }
 
-Bytes exception_pdu(std::uint8_t function, GatewayRefusal refusal) {
+Bytes exception_pdu(core::FunctionCode function, GatewayRefusal refusal) {
     return exception_pdu(function, exception_code(refusal));
 }
 
-ExceptionResponse exception_response(std::uint8_t function, GatewayRefusal refusal) noexcept {
+ExceptionResponse exception_response(core::FunctionCode function, GatewayRefusal refusal) noexcept {
     return exception_response(function, exception_code(refusal));
 }
 
-ExceptionResponse exception_response(std::uint8_t function, ExceptionCode code) noexcept {
-    return ExceptionResponse{function, code};
+ExceptionResponse exception_response(core::FunctionCode function, ExceptionCode code) noexcept {
+    return ExceptionResponse{function.value, code};
 }
 
 }  // namespace fieldbridge::protocol

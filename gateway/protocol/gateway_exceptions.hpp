@@ -33,24 +33,26 @@ enum class GatewayRefusal : std::uint8_t {
 /// 0x0A path_down / cancelled, 0x06 busy, 0x0B no_answer / expired, 0x04 gateway_failure.
 [[nodiscard]] ExceptionCode exception_code(GatewayRefusal refusal) noexcept;
 
-/// True for the function codes Modbus defines room for: 1..127.
-[[nodiscard]] constexpr bool is_function_code(std::uint8_t function) noexcept {
-    return core::is_function_code(core::FunctionCode{function});
+/// Why a request PDU that does not decode is refused: not_a_function for a function
+/// byte 0 or >= 0x80 (or an empty PDU), bad_value for any other (a quantity, byte count
+/// or length its function cannot carry: Modbus 6.x, 0x03).
+[[nodiscard]] constexpr GatewayRefusal refusal_for_undecodable(core::FunctionCode function) noexcept {
+    return core::is_function_code(function) ? GatewayRefusal::bad_value : GatewayRefusal::not_a_function;
 }
 
-/// The exception PDU to a request whose first byte is @p function (0 for an empty
-/// PDU): that byte with bit 7 set, then the code. The same rule for every byte, so
-/// a request with function byte 0 gets 0x80 and one with 0x80..0xFF gets its own
-/// byte back (encode_exception() takes real function codes only).
-/// The only place that lays out exception bytes (encode_exception() and
-/// encode_response() of an ExceptionResponse use it too).
-[[nodiscard]] Bytes exception_pdu(std::uint8_t function, ExceptionCode code);
-[[nodiscard]] Bytes exception_pdu(std::uint8_t function, GatewayRefusal refusal);
+/// The exception PDU to a request whose function code is @p function as it came
+/// (pdu_function(): FunctionCode{0} for an empty PDU): that byte with bit 7 set, then
+/// the code. The same rule for every byte, so a request with function byte 0 gets 0x80
+/// and one with 0x80..0xFF gets its own byte back (encode_exception() takes real
+/// function codes only). The only place that lays out exception bytes
+/// (encode_exception() and encode_response() of an ExceptionResponse use it too).
+[[nodiscard]] Bytes exception_pdu(core::FunctionCode function, ExceptionCode code);
+[[nodiscard]] Bytes exception_pdu(core::FunctionCode function, GatewayRefusal refusal);
 
 /// The same answers as a decoded Response (what the device agents and the MQTT
 /// sources hand back), encoded later by encode_response() into exception_pdu() bytes.
-[[nodiscard]] ExceptionResponse exception_response(std::uint8_t function, GatewayRefusal refusal) noexcept;
+[[nodiscard]] ExceptionResponse exception_response(core::FunctionCode function, GatewayRefusal refusal) noexcept;
 /// A code a profile decided (validate(), a device's "not executed"): only the form.
-[[nodiscard]] ExceptionResponse exception_response(std::uint8_t function, ExceptionCode code) noexcept;
+[[nodiscard]] ExceptionResponse exception_response(core::FunctionCode function, ExceptionCode code) noexcept;
 
 }  // namespace fieldbridge::protocol

@@ -95,12 +95,18 @@ std::uint8_t function_of(const Request& request) noexcept {
         request);
 }
 
-bool is_write(std::uint8_t function) noexcept {
+core::FunctionCode function_code(const Request& request) noexcept { return core::FunctionCode{function_of(request)}; }
+
+core::FunctionCode pdu_function(ByteView pdu) noexcept {
+    return pdu.empty() ? core::FunctionCode{} : core::FunctionCode{pdu[0]};
+}
+
+bool is_write(core::FunctionCode function) noexcept {
     // Only function codes that the public Modbus specification defines as pure reads
     // (6.1-6.4, 6.7, 6.9, 6.10, 6.13, 6.14, 6.18, 6.19, 6.21) count as reads. Everything
     // else, including user-defined and unknown codes, may change the device and is
     // treated as a write: never retried automatically (product spec, section 3 rule 6).
-    switch (static_cast<std::uint8_t>(function & ~fc::exception_flag)) {
+    switch (static_cast<std::uint8_t>(function.value & ~fc::exception_flag)) {
         case fc::read_coils:
         case fc::read_discrete_inputs:
         case fc::read_holding_registers:

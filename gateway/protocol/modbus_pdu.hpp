@@ -9,22 +9,41 @@
 #include <variant>
 #include <vector>
 
+#include "core/modbus_ids.hpp"
 #include "protocol/bytes.hpp"
 #include "protocol/decode_result.hpp"
 
 namespace fieldbridge::protocol {
 
+/// The function codes the codec knows, typed: what the gateway compares and decides on
+/// (core::FunctionCode, docs/architecture.md "One definition per concept").
+namespace fn {
+inline constexpr core::FunctionCode read_coils{0x01};
+inline constexpr core::FunctionCode read_discrete_inputs{0x02};
+inline constexpr core::FunctionCode read_holding_registers{0x03};
+inline constexpr core::FunctionCode read_input_registers{0x04};
+inline constexpr core::FunctionCode write_single_coil{0x05};
+inline constexpr core::FunctionCode write_single_register{0x06};
+inline constexpr core::FunctionCode read_exception_status{0x07};
+inline constexpr core::FunctionCode write_multiple_coils{0x0F};
+inline constexpr core::FunctionCode write_multiple_registers{0x10};
+inline constexpr core::FunctionCode read_write_multiple_registers{0x17};
+}  // namespace fn
+
+/// The same codes as the bytes of the wire: the codec's structs and byte layout, and the
+/// simulators, which build PDUs byte by byte. Gateway code decides on fn:: instead.
 namespace fc {
-inline constexpr std::uint8_t read_coils = 0x01;
-inline constexpr std::uint8_t read_discrete_inputs = 0x02;
-inline constexpr std::uint8_t read_holding_registers = 0x03;
-inline constexpr std::uint8_t read_input_registers = 0x04;
-inline constexpr std::uint8_t write_single_coil = 0x05;
-inline constexpr std::uint8_t write_single_register = 0x06;
-inline constexpr std::uint8_t read_exception_status = 0x07;
-inline constexpr std::uint8_t write_multiple_coils = 0x0F;
-inline constexpr std::uint8_t write_multiple_registers = 0x10;
-inline constexpr std::uint8_t read_write_multiple_registers = 0x17;
+inline constexpr std::uint8_t read_coils = fn::read_coils.value;
+inline constexpr std::uint8_t read_discrete_inputs = fn::read_discrete_inputs.value;
+inline constexpr std::uint8_t read_holding_registers = fn::read_holding_registers.value;
+inline constexpr std::uint8_t read_input_registers = fn::read_input_registers.value;
+inline constexpr std::uint8_t write_single_coil = fn::write_single_coil.value;
+inline constexpr std::uint8_t write_single_register = fn::write_single_register.value;
+inline constexpr std::uint8_t read_exception_status = fn::read_exception_status.value;
+inline constexpr std::uint8_t write_multiple_coils = fn::write_multiple_coils.value;
+inline constexpr std::uint8_t write_multiple_registers = fn::write_multiple_registers.value;
+inline constexpr std::uint8_t read_write_multiple_registers = fn::read_write_multiple_registers.value;
+/// Bit 7 of the function byte: set in an exception reply (section 7).
 inline constexpr std::uint8_t exception_flag = 0x80;
 }  // namespace fc
 
@@ -164,13 +183,30 @@ using Response = std::variant<ReadBitsResponse, ReadRegistersResponse, WriteSing
 
 // ---- codec ----------------------------------------------------------------------
 
+/// The function byte of a request as the codec lays it out (the codec and the
+/// simulators); the gateway decides on function_code().
 [[nodiscard]] std::uint8_t function_of(const Request& request) noexcept;
+
+/// The function code of a decoded request, typed.
+[[nodiscard]] core::FunctionCode function_code(const Request& request) noexcept;
+
+/// The function code of one decoded PDU struct (ReadRegistersRequest, ExceptionResponse,
+/// ...), typed: their `function` fields stay the wire's byte.
+template <class Pdu>
+    requires requires(const Pdu& pdu) { std::uint8_t{pdu.function}; }
+[[nodiscard]] constexpr core::FunctionCode function_code(const Pdu& pdu) noexcept {
+    return core::FunctionCode{pdu.function};
+}
+
+/// The function code a raw PDU starts with, as it came (0 .. 0xFF, is_function_code()
+/// tells whether it is one); FunctionCode{0} for an empty PDU, which is answered 0x80.
+[[nodiscard]] core::FunctionCode pdu_function(ByteView pdu) noexcept;
 
 /// False only for the function codes the Modbus specification defines as reads
 /// (01, 02, 03, 04, 07, 0B, 0C, 11, 14, 18, 2B); every other code, unknown ones
 /// included, may change the device and counts as a write (never auto-retried).
 /// The exception flag 0x80 is ignored.
-[[nodiscard]] bool is_write(std::uint8_t function) noexcept;
+[[nodiscard]] bool is_write(core::FunctionCode function) noexcept;
 
 /// Encodes a request PDU. Throws core::InvalidArgument when the request breaks a
 /// protocol limit (count 0 or above the maximum, empty write): callers validate first.

@@ -184,7 +184,7 @@ Bytes encode_exception(std::uint8_t function, ExceptionCode code) {
     if (function == 0 || (function & fc::exception_flag) != 0) {
         reject(function, "exception", "function code must be 1..127 (without the 0x80 flag)");
     }
-    return exception_pdu(function, code);
+    return exception_pdu(core::FunctionCode{function}, code);
 }
 
 DecodeResult<Response> decode_response(ByteView pdu, const Request& request) {

@@ -158,8 +158,8 @@ constexpr std::uint16_t ralarm = 0x02D6;
 
 [[nodiscard]] WireFunctions excd_wire_functions() {
     // Seed 002 §2: FC03, FC06, FC10 only.
-    return WireFunctions{{protocol::fc::read_holding_registers, protocol::fc::write_single_register,
-                          protocol::fc::write_multiple_registers},
+    return WireFunctions{{protocol::fn::read_holding_registers, protocol::fn::write_single_register,
+                          protocol::fn::write_multiple_registers},
                          false, false};
 }
 

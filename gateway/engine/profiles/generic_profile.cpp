@@ -80,10 +80,10 @@ void check_block(const GenericBlock& b) {
 }
 
 [[nodiscard]] WireFunctions generic_wire_functions() {
-    namespace fc = protocol::fc;
-    return WireFunctions{{fc::read_coils, fc::read_discrete_inputs, fc::read_holding_registers,
-                          fc::read_input_registers, fc::write_single_coil, fc::write_single_register,
-                          fc::write_multiple_coils, fc::write_multiple_registers},
+    namespace fn = protocol::fn;
+    return WireFunctions{{fn::read_coils, fn::read_discrete_inputs, fn::read_holding_registers,
+                          fn::read_input_registers, fn::write_single_coil, fn::write_single_register,
+                          fn::write_multiple_coils, fn::write_multiple_registers},
                          false, false};
 }
 

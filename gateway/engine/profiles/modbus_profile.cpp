@@ -13,7 +13,7 @@ namespace {
 
 using protocol::ExceptionCode;
 
-[[nodiscard]] protocol::Response failure(std::uint8_t function, ExceptionCode code) {
+[[nodiscard]] protocol::Response failure(core::FunctionCode function, ExceptionCode code) {
     return protocol::exception_response(function, code);
 }
 
@@ -104,7 +104,7 @@ std::vector<Payload> ModbusProfile::to_line(const protocol::Request& request, co
         [&](const auto& r) {
             using T = std::decay_t<decltype(r)>;
             if constexpr (std::is_same_v<T, protocol::ReadRegistersRequest>) {
-                const Table table = r.function == protocol::fc::read_input_registers ? Table::input : Table::holding;
+                const Table table = table_of_read(protocol::function_code(r));
                 const std::vector<UnitRef> units = map_->units(table, r.address, r.count);
                 if (!swaps() || units.empty()) {
                     out.push_back(ModbusPayload{r});
@@ -200,7 +200,7 @@ ApplyResult ModbusProfile::apply(const Payload& sent, const Reply& reply, Regist
     }
     const protocol::Request& req = payload->request;
     if (const auto* ex = std::get_if<protocol::ExceptionResponse>(response)) {
-        if (ex->function != protocol::function_of(req)) {
+        if (protocol::function_code(*ex) != protocol::function_code(req)) {
             result.status = ApplyStatus::not_applicable;
             return result;
         }
@@ -218,7 +218,7 @@ ApplyResult ModbusProfile::apply(const Payload& sent, const Reply& reply, Regist
             using T = std::decay_t<decltype(r)>;
             if constexpr (std::is_same_v<T, protocol::ReadBitsRequest>) {
                 const auto* bits = std::get_if<protocol::ReadBitsResponse>(response);
-                if (bits == nullptr || bits->function != r.function || bits->bits.size() < r.count) {
+                if (bits == nullptr || protocol::function_code(*bits) != protocol::function_code(r) || bits->bits.size() < r.count) {
                     handled = false;
                     return;
                 }
@@ -226,15 +226,15 @@ ApplyResult ModbusProfile::apply(const Payload& sent, const Reply& reply, Regist
                 for (std::size_t i = 0; i < r.count; ++i) {
                     values[i] = bits->bits[i] ? 1 : 0;
                 }
-                const Table table = r.function == protocol::fc::read_coils ? Table::coils : Table::discrete_inputs;
+                const Table table = table_of_read(protocol::function_code(r));
                 store(image, table, r.address, std::move(values), false, false, now);
             } else if constexpr (std::is_same_v<T, protocol::ReadRegistersRequest>) {
                 const auto* regs = std::get_if<protocol::ReadRegistersResponse>(response);
-                if (regs == nullptr || regs->function != r.function || regs->values.size() != r.count) {
+                if (regs == nullptr || protocol::function_code(*regs) != protocol::function_code(r) || regs->values.size() != r.count) {
                     handled = false;
                     return;
                 }
-                const Table table = r.function == protocol::fc::read_input_registers ? Table::input : Table::holding;
+                const Table table = table_of_read(protocol::function_code(r));
                 store(image, table, r.address, regs->values, true, false, now);
             } else if constexpr (std::is_same_v<T, protocol::WriteSingleRegisterRequest> ||
                                  std::is_same_v<T, protocol::WriteSingleCoilRequest> ||
@@ -259,7 +259,7 @@ ApplyResult ModbusProfile::apply(const Payload& sent, const Reply& reply, Regist
 
 protocol::Response ModbusProfile::respond(const protocol::Request& request, std::span<const Reply> replies,
                                           const RegisterImage& image) const {
-    const std::uint8_t function = protocol::function_of(request);
+    const core::FunctionCode function = protocol::function_code(request);
     for (const Reply& reply : replies) {
         const auto* response = std::get_if<protocol::Response>(&reply);
         if (response == nullptr) {
@@ -287,7 +287,7 @@ protocol::Response ModbusProfile::respond(const protocol::Request& request, std:
                 return protocol::ReadBitsResponse{r.function,
                                                   std::vector<bool>(bits->bits.begin(), bits->bits.begin() + r.count)};
             } else if constexpr (std::is_same_v<T, protocol::ReadRegistersRequest>) {
-                const Table table = r.function == protocol::fc::read_input_registers ? Table::input : Table::holding;
+                const Table table = table_of_read(protocol::function_code(r));
                 std::vector<std::uint16_t> out(r.count);
                 std::vector<bool> filled(r.count, false);
                 for (std::size_t k = 0; k < payloads.size(); ++k) {
@@ -328,7 +328,7 @@ protocol::Response ModbusProfile::respond(const protocol::Request& request, std:
                     return protocol::WriteSingleResponse{protocol::fc::write_single_coil, r.address,
                                                          static_cast<std::uint16_t>(r.value ? 0xFF00 : 0x0000)};
                 } else {
-                    return protocol::WriteMultipleResponse{function, r.address,
+                    return protocol::WriteMultipleResponse{function.value, r.address,
                                                            static_cast<std::uint16_t>(r.values.size())};
                 }
             } else {

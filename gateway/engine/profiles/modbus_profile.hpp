@@ -19,7 +19,7 @@ namespace fieldbridge::engine {
 
 /// How northbound function codes map to the wire.
 struct WireFunctions {
-    std::vector<std::uint8_t> northbound;  ///< accepted from clients (others: 0x01)
+    std::vector<core::FunctionCode> northbound;  ///< accepted from clients (others: 0x01)
     bool fc06_as_fc16 = false;  ///< the device lacks FC06: send FC16 with one register
     bool fc16_as_fc06 = false;  ///< the device lacks FC16: send one FC06 per register
 };

@@ -10,14 +10,14 @@ namespace fieldbridge::engine {
 
 namespace {
 
-[[nodiscard]] std::uint8_t read_function(Table table) noexcept {
+[[nodiscard]] core::FunctionCode read_function(Table table) noexcept {
     switch (table) {
-        case Table::coils: return protocol::fc::read_coils;
-        case Table::discrete_inputs: return protocol::fc::read_discrete_inputs;
-        case Table::holding: return protocol::fc::read_holding_registers;
-        case Table::input: return protocol::fc::read_input_registers;
+        case Table::coils: return protocol::fn::read_coils;
+        case Table::discrete_inputs: return protocol::fn::read_discrete_inputs;
+        case Table::holding: return protocol::fn::read_holding_registers;
+        case Table::input: return protocol::fn::read_input_registers;
     }
-    return protocol::fc::read_holding_registers;
+    return protocol::fn::read_holding_registers;
 }
 
 [[nodiscard]] std::size_t block_limit(Table table) noexcept {
@@ -48,11 +48,11 @@ const char* to_string(PollClass poll_class) noexcept {
 }
 
 Payload read_payload(const RegisterSpan& span) {
-    const std::uint8_t function = read_function(span.table);
+    const core::FunctionCode function = read_function(span.table);
     if (is_bit_table(span.table)) {
-        return ModbusPayload{protocol::ReadBitsRequest{function, span.address, span.count}};
+        return ModbusPayload{protocol::ReadBitsRequest{function.value, span.address, span.count}};
     }
-    return ModbusPayload{protocol::ReadRegistersRequest{function, span.address, span.count}};
+    return ModbusPayload{protocol::ReadRegistersRequest{function.value, span.address, span.count}};
 }
 
 std::vector<PollItem> merge_units(std::vector<PollUnit> units) {

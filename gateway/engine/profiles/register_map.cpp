@@ -11,18 +11,12 @@
 
 namespace fieldbridge::engine {
 
-namespace {
-
-[[nodiscard]] Table table_of_read(std::uint8_t function) noexcept {
-    switch (function) {
-        case protocol::fc::read_coils: return Table::coils;
-        case protocol::fc::read_discrete_inputs: return Table::discrete_inputs;
-        case protocol::fc::read_input_registers: return Table::input;
-        default: return Table::holding;
-    }
+Table table_of_read(core::FunctionCode function) noexcept {
+    if (function == protocol::fn::read_coils) return Table::coils;
+    if (function == protocol::fn::read_discrete_inputs) return Table::discrete_inputs;
+    if (function == protocol::fn::read_input_registers) return Table::input;
+    return Table::holding;
 }
-
-}  // namespace
 
 std::optional<RequestSpan> request_span(const protocol::Request& request) {
     return std::visit(
@@ -30,7 +24,7 @@ std::optional<RequestSpan> request_span(const protocol::Request& request) {
             using T = std::decay_t<decltype(r)>;
             if constexpr (std::is_same_v<T, protocol::ReadBitsRequest> ||
                           std::is_same_v<T, protocol::ReadRegistersRequest>) {
-                return RequestSpan{table_of_read(r.function), r.address, r.count, false, {}};
+                return RequestSpan{table_of_read(protocol::function_code(r)), r.address, r.count, false, {}};
             } else if constexpr (std::is_same_v<T, protocol::WriteSingleCoilRequest>) {
                 return RequestSpan{Table::coils, r.address, 1, true, {static_cast<std::uint16_t>(r.value ? 1 : 0)}};
             } else if constexpr (std::is_same_v<T, protocol::WriteSingleRegisterRequest>) {
@@ -151,9 +145,9 @@ std::vector<WrittenUnit> written_units(const RegisterMap& map, const RequestSpan
 }
 
 std::optional<protocol::ExceptionCode> validate_request(const RegisterMap& map, const protocol::Request& request,
-                                                        std::span<const std::uint8_t> functions,
+                                                        std::span<const core::FunctionCode> functions,
                                                         bool allow_protected, const ValueCheck& extra) {
-    const std::uint8_t function = protocol::function_of(request);
+    const core::FunctionCode function = protocol::function_code(request);
     if (std::find(functions.begin(), functions.end(), function) == functions.end()) {
         return protocol::ExceptionCode::illegal_function;
     }
@@ -198,7 +192,7 @@ std::optional<protocol::ExceptionCode> validate_request(const RegisterMap& map, 
 
 Classification classify_request(const RegisterMap& map, const protocol::Request& request) {
     Classification c;
-    c.write = protocol::is_write(protocol::function_of(request));
+    c.write = protocol::is_write(protocol::function_code(request));
     c.idempotent = !c.write;
     const std::optional<RequestSpan> span = request_span(request);
     if (!c.write || !span) {

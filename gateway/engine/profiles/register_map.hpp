@@ -67,6 +67,10 @@ struct RequestSpan {
 };
 [[nodiscard]] std::optional<RequestSpan> request_span(const protocol::Request& request);
 
+/// The table a read function reads: FC01 coils, FC02 discrete inputs, FC04 input
+/// registers, anything else (FC03) holding registers.
+[[nodiscard]] Table table_of_read(core::FunctionCode function) noexcept;
+
 /// The 32-bit value of a pair written high word first.
 [[nodiscard]] constexpr std::int64_t pair_value(std::uint16_t high, std::uint16_t low, bool is_signed) noexcept {
     const std::uint32_t raw = (std::uint32_t{high} << 16) | low;
@@ -119,7 +123,7 @@ using ValueCheck = std::function<std::optional<protocol::ExceptionCode>(const Re
 /// @p extra. Requests without a span (FC07) pass when their function is listed.
 [[nodiscard]] std::optional<protocol::ExceptionCode> validate_request(const RegisterMap& map,
                                                                       const protocol::Request& request,
-                                                                      std::span<const std::uint8_t> functions,
+                                                                      std::span<const core::FunctionCode> functions,
                                                                       bool allow_protected,
                                                                       const ValueCheck& extra);
 

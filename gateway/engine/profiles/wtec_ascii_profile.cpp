@@ -114,11 +114,11 @@ void sources_of(Table table, std::uint16_t address, std::array<bool, src_count>&
     return defs;
 }
 
-[[nodiscard]] const std::array<std::uint8_t, 4>& view_functions() {
+[[nodiscard]] const std::array<core::FunctionCode, 4>& view_functions() {
     // Reads of both tables, writes of single and multiple holding registers.
-    static constexpr std::array<std::uint8_t, 4> functions{
-        protocol::fc::read_holding_registers, protocol::fc::read_input_registers,
-        protocol::fc::write_single_register, protocol::fc::write_multiple_registers};
+    static constexpr std::array<core::FunctionCode, 4> functions{
+        protocol::fn::read_holding_registers, protocol::fn::read_input_registers,
+        protocol::fn::write_single_register, protocol::fn::write_multiple_registers};
     return functions;
 }
 
@@ -133,7 +133,7 @@ void sources_of(Table table, std::uint16_t address, std::array<bool, src_count>&
     return item;
 }
 
-[[nodiscard]] protocol::Response exception_reply(std::uint8_t function, ExceptionCode code) {
+[[nodiscard]] protocol::Response exception_reply(core::FunctionCode function, ExceptionCode code) {
     return protocol::exception_response(function, code);
 }
 
@@ -427,7 +427,7 @@ ApplyResult WtecAsciiProfile::apply(const Payload& sent, const Reply& reply, Reg
 
 protocol::Response WtecAsciiProfile::respond(const protocol::Request& request, std::span<const Reply> replies,
                                              const RegisterImage& image) const {
-    const std::uint8_t function = protocol::function_of(request);
+    const core::FunctionCode function = protocol::function_code(request);
     const std::optional<RequestSpan> span = request_span(request);
     if (!span || replies.empty() || replies.size() != to_line(request, image).size()) {
         return exception_reply(function, ExceptionCode::gateway_target_failed);
@@ -448,7 +448,7 @@ protocol::Response WtecAsciiProfile::respond(const protocol::Request& request, s
         if (const auto* single = std::get_if<protocol::WriteSingleRegisterRequest>(&request)) {
             return protocol::WriteSingleResponse{protocol::fc::write_single_register, single->address, single->value};
         }
-        return protocol::WriteMultipleResponse{function, span->address, span->count};
+        return protocol::WriteMultipleResponse{function.value, span->address, span->count};
     }
     std::vector<std::uint16_t> values;
     values.reserve(span->count);
@@ -459,7 +459,7 @@ protocol::Response WtecAsciiProfile::respond(const protocol::Request& request, s
         }
         values.push_back(*v);
     }
-    return protocol::ReadRegistersResponse{function, std::move(values)};
+    return protocol::ReadRegistersResponse{function.value, std::move(values)};
 }
 
 bool WtecAsciiProfile::in_motion(const RegisterImage& image) const {

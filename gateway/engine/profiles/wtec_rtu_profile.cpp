@@ -10,8 +10,8 @@ namespace {
 
 [[nodiscard]] WireFunctions wtec_rtu_wire_functions() {
     // Seed 003 §2.1.1: "常见功能码有 03、06"; FC16 is translated to FC06s.
-    return WireFunctions{{protocol::fc::read_holding_registers, protocol::fc::write_single_register,
-                          protocol::fc::write_multiple_registers},
+    return WireFunctions{{protocol::fn::read_holding_registers, protocol::fn::write_single_register,
+                          protocol::fn::write_multiple_registers},
                          false, true};
 }
 

@@ -106,9 +106,9 @@ constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1"
 
 [[nodiscard]] WireFunctions xeg_wire_functions() {
     // Seed 001 §4.1 function code table; FC06 is accepted northbound and translated.
-    return WireFunctions{{protocol::fc::read_discrete_inputs, protocol::fc::read_holding_registers,
-                          protocol::fc::read_input_registers, protocol::fc::write_single_register,
-                          protocol::fc::read_exception_status, protocol::fc::write_multiple_registers},
+    return WireFunctions{{protocol::fn::read_discrete_inputs, protocol::fn::read_holding_registers,
+                          protocol::fn::read_input_registers, protocol::fn::write_single_register,
+                          protocol::fn::read_exception_status, protocol::fn::write_multiple_registers},
                          true, false};
 }
 

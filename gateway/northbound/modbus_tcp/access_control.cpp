@@ -33,8 +33,9 @@ constexpr config::RegisterRange every_register{0x0000, 0xFFFF};
 
 /// Function codes that read no register and change nothing (Modbus 6.7, 6.9, 6.10,
 /// 6.13: read exception status, get comm event counter / log, report server ID).
-[[nodiscard]] bool touches_no_register(std::uint8_t function) noexcept {
-    return function == 0x07 || function == 0x0B || function == 0x0C || function == 0x11;
+[[nodiscard]] bool touches_no_register(core::FunctionCode function) noexcept {
+    return function == protocol::fn::read_exception_status || function == core::FunctionCode{0x0B} ||
+           function == core::FunctionCode{0x0C} || function == core::FunctionCode{0x11};
 }
 
 }  // namespace
@@ -45,7 +46,8 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
         scope.first = every_register;
         return scope;
     }
-    scope.function = core::FunctionCode{pdu[0]};
+    scope.function = protocol::pdu_function(pdu);
+    // The byte selects the layout of the fields to read: the codec's constants.
     namespace fc = protocol::fc;
     switch (scope.function.value) {
         case fc::read_coils:
@@ -71,7 +73,7 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
             }
             break;
         default:
-            if (touches_no_register(scope.function.value)) return scope;
+            if (touches_no_register(scope.function)) return scope;
             break;  // FC08, 14, 15, 18, 2B, vendor codes: what they touch is not known
     }
     // A PDU too short for its address fields, or a function code whose registers

@@ -256,7 +256,7 @@ void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, proto
             peer_, e.what());
         if (slot.busy && slot.generation == generation) {
             complete(index, generation,
-                     protocol::exception_pdu(function.value, protocol::GatewayRefusal::gateway_failure));
+                     protocol::exception_pdu(function, protocol::GatewayRefusal::gateway_failure));
         }
     }
 }
@@ -290,7 +290,7 @@ void Connection::complete(std::uint16_t index, std::uint32_t generation, protoco
 
 void Connection::respond_exception(std::uint16_t transaction_id, core::UnitId unit, core::FunctionCode function,
                                    protocol::GatewayRefusal refusal) {
-    respond(transaction_id, unit, protocol::exception_pdu(function.value, refusal));
+    respond(transaction_id, unit, protocol::exception_pdu(function, refusal));
 }
 
 void Connection::respond(std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu) {

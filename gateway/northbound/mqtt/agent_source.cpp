@@ -91,7 +91,7 @@ std::optional<protocol::ExceptionCode> AgentSource::validate(const protocol::Req
 
 void AgentSource::execute(const protocol::Request& request, engine::ResponseHandler done) {
     if (agent_ == nullptr) {
-        const std::uint8_t function = protocol::function_of(request);
+        const core::FunctionCode function = protocol::function_code(request);
         asio::post(io_, [done = std::move(done), function] {
             done(protocol::Response{protocol::exception_response(function, protocol::GatewayRefusal::path_down)});
         });

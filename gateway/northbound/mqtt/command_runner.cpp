@@ -66,7 +66,7 @@ std::string describe(const protocol::Request& request) {
             } else if constexpr (std::is_same_v<R, protocol::WriteMultipleCoilsRequest>) {
                 return "FC15 " + hex(r.address, 4) + " x" + std::to_string(r.values.size());
             } else {
-                return "FC" + hex(protocol::function_of(protocol::Request{r}), 2).substr(2);
+                return "FC" + hex(protocol::function_code(protocol::Request{r}).value, 2).substr(2);
             }
         },
         request);

@@ -82,7 +82,7 @@ public:
     }
 
     void execute(const protocol::Request& request, engine::ResponseHandler done) override {
-        const std::uint8_t function = protocol::function_of(request);
+        const core::FunctionCode function = protocol::function_code(request);
         if (hub_->target == nullptr) {
             asio::post(io_, [done = std::move(done), function] {
                 done(protocol::exception_response(function, protocol::GatewayRefusal::path_down));

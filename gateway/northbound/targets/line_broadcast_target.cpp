@@ -55,7 +55,7 @@ struct LineBroadcastTarget::Operation {
     protocol::Request request;
     std::vector<BroadcastStep> steps;
     std::size_t next = 0;
-    std::uint8_t function = 0;
+    core::FunctionCode function;
     protocol::Bytes echo;
     PduHandler done;
 
@@ -99,14 +99,12 @@ void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView reque
                                  PduHandler done) {
     asio::io_context& io = shared_->io;
     auto op = std::make_shared<Operation>();
-    op->function = request_pdu.empty() ? 0 : request_pdu[0];
+    op->function = protocol::pdu_function(request_pdu);
     op->done = std::move(done);
     const auto refuse = [&](protocol::Bytes pdu) { op->answer(io, std::move(pdu)); };
     const auto decoded = protocol::decode_request(request_pdu);
     if (!decoded.complete()) {
-        refuse(protocol::exception_pdu(op->function, protocol::is_function_code(op->function)
-                                                         ? GatewayRefusal::bad_value
-                                                         : GatewayRefusal::not_a_function));
+        refuse(protocol::exception_pdu(op->function, protocol::refusal_for_undecodable(op->function)));
         return;
     }
     const auto echo = write_echo(decoded.value);

@@ -19,13 +19,9 @@ void SerialDeviceTarget::answer(PduHandler done, protocol::Bytes pdu) {
 void SerialDeviceTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
                                 PduHandler done) {
     const auto decoded = protocol::decode_request(request_pdu);
-    const std::uint8_t function = request_pdu.empty() ? 0 : request_pdu[0];
+    const core::FunctionCode function = protocol::pdu_function(request_pdu);
     if (!decoded.complete()) {
-        // A function byte 0 / >= 0x80 is no function at all; anything else that does
-        // not decode has a bad quantity, byte count or length (Modbus 6.x: 0x03).
-        answer(std::move(done), protocol::exception_pdu(function, protocol::is_function_code(function)
-                                                                      ? protocol::GatewayRefusal::bad_value
-                                                                      : protocol::GatewayRefusal::not_a_function));
+        answer(std::move(done), protocol::exception_pdu(function, protocol::refusal_for_undecodable(function)));
         return;
     }
     if (!line_.line_up()) {

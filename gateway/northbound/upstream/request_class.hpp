@@ -3,34 +3,19 @@
 /// What a pass-through request is, from its PDU alone (pure): its priority class
 /// (spec §3 rule 2: any write is a command), whether it is a stop that jumps ahead of
 /// other commands (rule 4), and which stateful R6 sequences it takes part in
-/// (spec §5: counter read, data-source view, data-source upload; docs/r6-passthrough.md).
+/// (spec §5; docs/r6-passthrough.md). Which registers those are is the R6's
+/// knowledge (r6_sequences.hpp): this file decodes and asks.
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 
 #include "engine/transaction.hpp"
+#include "northbound/upstream/r6_sequences.hpp"
 #include "protocol/bytes.hpp"
-#include "protocol/modbus_pdu.hpp"
+#include "protocol/gateway_exceptions.hpp"
 
 namespace fieldbridge::northbound::upstream {
-
-/// A stateful indirection of the R6: a write selects, a later request uses the selection.
-enum class Resource : std::uint8_t {
-    counter_read,   ///< 0x0883 ID, then read 0x0883-0x0888
-    source_view,    ///< 0x7530 data source ID, then read its length at 0x7531
-    source_upload,  ///< 0x7532-0x7534 set-up, then uploads from 0x7535
-};
-inline constexpr std::size_t resource_count = 3;
-[[nodiscard]] const char* to_string(Resource resource) noexcept;
-
-/// The part a request plays in a resource's sequence.
-enum class Role : std::uint8_t {
-    none,    ///< does not touch the resource
-    begin,   ///< selects (writes the set-up registers): the client takes the resource
-    use,     ///< touches it without ending the sequence (an upload, a stray access)
-    finish,  ///< reads the result: the sequence ends when it completes
-};
 
 struct RequestClass {
     engine::Priority priority = engine::Priority::on_demand;
@@ -46,12 +31,12 @@ struct RequestClass {
 
 /// A request that is answered locally, never sent.
 struct LocalAnswer {
-    protocol::ExceptionCode code = protocol::ExceptionCode::illegal_function;
+    protocol::GatewayRefusal refusal = protocol::GatewayRefusal::not_a_function;
 };
 
-/// Classifies @p pdu. A PDU that a known function code cannot carry (length, byte
-/// count, quantity 0 or above the Modbus limit) is answered 0x03, a function code of
-/// 0 or >= 0x80 is answered 0x01 (spec §4: answered locally when known invalid).
+/// Classifies @p pdu. A PDU that does not decode is answered locally (spec §4: known
+/// invalid) with protocol::refusal_for_undecodable(): 0x01 for a function code of 0 or
+/// >= 0x80, 0x03 for one that cannot carry its length, byte count or quantity.
 /// Unknown function codes are forwarded: a command unless the Modbus specification
 /// defines them as reads (protocol::is_write), with no resource.
 struct Classified {

@@ -11,7 +11,8 @@ constexpr std::size_t index_of(Resource resource) noexcept { return static_cast<
 constexpr std::array<Resource, resource_count> all_resources{Resource::counter_read, Resource::source_view,
                                                              Resource::source_upload};
 
-std::uint8_t function_of(const protocol::Bytes& pdu) noexcept { return pdu.empty() ? 0 : pdu[0]; }
+/// The function byte of a PDU, for the log (0 for an empty PDU).
+std::uint8_t function_byte(const protocol::Bytes& pdu) noexcept { return protocol::pdu_function(pdu).value; }
 
 }  // namespace
 
@@ -44,7 +45,7 @@ void UpstreamScheduler::submit(UpstreamRequest request, TimePoint now) {
             log_(engine::LogLevel::warning,
                  fmt::format("upstream queue full ({} requests waiting): request FC{:02X} from client {} "
                              "refused with 0x06; raise queue_limit or poll less",
-                             waiting, function_of(entry.request.pdu), entry.request.client));
+                             waiting, function_byte(entry.request.pdu), entry.request.client));
             complete(entry, UpstreamStatus::queue_full);
             return;
         }
@@ -127,7 +128,7 @@ std::optional<Dispatch> UpstreamScheduler::next(TimePoint now) {
     if (log_.enabled(engine::LogLevel::debug)) {
         log_(engine::LogLevel::debug,
              fmt::format("upstream: sending txid {} FC{:02X} unit {} ({}, client {})", d.transaction_id,
-                         function_of(d.pdu), d.unit.value, entry.request.poll ? "poll" : "request",
+                         function_byte(d.pdu), d.unit.value, entry.request.poll ? "poll" : "request",
                          entry.request.client));
     }
     flight_.push_back(std::move(entry));
@@ -205,17 +206,18 @@ bool UpstreamScheduler::reply(std::uint16_t transaction_id, core::UnitId unit, p
     Entry entry = std::move(*it);
     flight_.erase(it);
     consecutive_timeouts_ = 0;
-    const std::uint8_t asked = function_of(entry.request.pdu);
-    const std::uint8_t got = function_of(pdu);
-    if ((got & 0x7F) != asked) {
+    const core::FunctionCode asked = protocol::pdu_function(entry.request.pdu);
+    const core::FunctionCode got = protocol::pdu_function(pdu);
+    const bool exception = (got.value & protocol::fc::exception_flag) != 0;
+    if (core::FunctionCode{static_cast<std::uint8_t>(got.value & ~protocol::fc::exception_flag)} != asked) {
         log_(engine::LogLevel::warning,
              fmt::format("upstream: reply to FC{:02X} (txid {}) carries FC{:02X}: answered 0x0B; the "
-                         "upstream server is confused", asked, transaction_id, got));
+                         "upstream server is confused", asked.value, transaction_id, got.value));
         on_finished(entry, false, false, now);
         complete(entry, UpstreamStatus::timeout);
         return true;
     }
-    on_finished(entry, true, (got & protocol::fc::exception_flag) != 0, now);
+    on_finished(entry, true, exception, now);
     complete(entry, UpstreamStatus::ok, std::move(pdu));
     return true;
 }
@@ -225,7 +227,7 @@ void UpstreamScheduler::expire_commands(TimePoint now) {
         if (it->deadline && *it->deadline <= now) {
             log_(engine::LogLevel::warning,
                  fmt::format("upstream: command FC{:02X} from client {} not sent: it waited {} ms, past "
-                             "command_ttl; answered 0x0B", function_of(it->request.pdu), it->request.client,
+                             "command_ttl; answered 0x0B", function_byte(it->request.pdu), it->request.client,
                              std::chrono::duration_cast<std::chrono::milliseconds>(now - it->enqueued).count()));
             complete(*it, UpstreamStatus::expired);
             it = queue_.erase(it);
@@ -241,7 +243,7 @@ void UpstreamScheduler::tick(TimePoint now) {
             ++consecutive_timeouts_;
             log_(engine::LogLevel::warning,
                  fmt::format("upstream: no reply to txid {} FC{:02X} unit {} within {} ms; answered 0x0B "
-                             "(not retried)", it->transaction_id, function_of(it->request.pdu), it->request.unit.value,
+                             "(not retried)", it->transaction_id, function_byte(it->request.pdu), it->request.unit.value,
                              std::chrono::duration_cast<std::chrono::milliseconds>(settings_.response_timeout).count()));
             Entry entry = std::move(*it);
             it = flight_.erase(it);

@@ -12,7 +12,7 @@
 /// - commands that could not start before `command_ttl` are never sent (rule 9);
 /// - a request with no reply within `response_timeout` fails (0x0B), never retried;
 /// - stateful R6 sequences never interleave: a client that begins one (the counter
-///   ID write to 0x0883, the data-source set-up at 0x7532...) holds that resource
+///   ID write, the data-source set-up...: r6_sequences.hpp) holds that resource
 ///   until the sequence finishes, lapses (`sequence_hold` without the owner touching
 ///   it, or `sequence_max_hold` after it began, whatever the owner does) or the
 ///   client closes; meanwhile other clients' requests touching the resource wait,

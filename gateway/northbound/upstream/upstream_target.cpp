@@ -24,7 +24,7 @@ using protocol::GatewayRefusal;
 /// spec §4 through the gateway's one mapping (protocol/gateway_exceptions.hpp):
 /// 0x0A the path is unavailable (nothing was sent), 0x0B the target did not answer in
 /// time (or the command's deadline passed), 0x06 the queue is full.
-protocol::Bytes answer_pdu(std::uint8_t function, const UpstreamOutcome& outcome) {
+protocol::Bytes answer_pdu(core::FunctionCode function, const UpstreamOutcome& outcome) {
     switch (outcome.status) {
         case UpstreamStatus::ok: return outcome.response_pdu;
         case UpstreamStatus::timeout: return exception_pdu(function, GatewayRefusal::no_answer);
@@ -106,7 +106,7 @@ public:
 
     void handle(core::UnitId unit_id, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
         ++stats_.requests;
-        const std::uint8_t function = pdu.empty() ? 0 : pdu[0];
+        const core::FunctionCode function = protocol::pdu_function(pdu);
         const Unit* unit = find(unit_id);
         if (unit == nullptr || !started_) {
             answer_later(std::move(done), exception_pdu(function, GatewayRefusal::path_down));
@@ -114,7 +114,7 @@ public:
         }
         const Classified classified = classify(pdu);
         if (!classified.request) {
-            answer_later(std::move(done), exception_pdu(function, classified.local.code));
+            answer_later(std::move(done), exception_pdu(function, classified.local.refusal));
             return;
         }
         const LinkState link = link_->state();
@@ -158,8 +158,8 @@ public:
             log_(engine::LogLevel::warning,
                  fmt::format("upstream {}: unit {} sent a malformed reply to function 0x{:02X} ({}; {} bytes, "
                              "first 0x{:02X}); the client gets exception 0x04, nothing of it is passed on",
-                             config_.name, unit_id.value, asked.empty() ? 0 : asked[0],
-                             protocol::to_string(decoded.error), reply.size(), reply.empty() ? 0 : reply[0]));
+                             config_.name, unit_id.value, protocol::pdu_function(asked).value,
+                             protocol::to_string(decoded.error), reply.size(), protocol::pdu_function(reply).value));
         }
         return true;
     }

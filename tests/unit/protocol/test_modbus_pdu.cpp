@@ -411,11 +411,11 @@ TEST_CASE("pdu: response length prediction") {
 TEST_CASE("pdu: is_write") {
     for (const int read : {0x01, 0x02, 0x03, 0x04, 0x07, 0x0B, 0x0C, 0x11, 0x14, 0x18, 0x2B, 0x83}) {
         CAPTURE(read);
-        CHECK_FALSE(p::is_write(static_cast<std::uint8_t>(read)));
+        CHECK_FALSE(p::is_write(fieldbridge::core::FunctionCode{static_cast<std::uint8_t>(read)}));
     }
     for (const int write : {0x05, 0x06, 0x08, 0x0F, 0x10, 0x15, 0x16, 0x17, 0x41, 0x64, 0x90}) {
         CAPTURE(write);
-        CHECK(p::is_write(static_cast<std::uint8_t>(write)));
+        CHECK(p::is_write(fieldbridge::core::FunctionCode{static_cast<std::uint8_t>(write)}));
     }
 }
 

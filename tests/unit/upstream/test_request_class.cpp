@@ -65,13 +65,19 @@ TEST_CASE("data-source view and upload") {
 
 TEST_CASE("PDUs no function code can carry are answered locally") {
     CHECK_FALSE(classify(Bytes{}).request);
-    CHECK(classify(Bytes{}).local.code == protocol::ExceptionCode::illegal_function);
-    CHECK(classify(Bytes{0x00, 0x01}).local.code == protocol::ExceptionCode::illegal_function);
-    CHECK(classify(Bytes{0x83, 0x02}).local.code == protocol::ExceptionCode::illegal_function);
+    CHECK(classify(Bytes{}).local.refusal == protocol::GatewayRefusal::not_a_function);
+    CHECK(classify(Bytes{0x00, 0x01}).local.refusal == protocol::GatewayRefusal::not_a_function);
+    CHECK(classify(Bytes{0x83, 0x02}).local.refusal == protocol::GatewayRefusal::not_a_function);
     const Classified zero = classify(Bytes{0x03, 0x08, 0x89, 0x00, 0x00});
     CHECK_FALSE(zero.request);
-    CHECK(zero.local.code == protocol::ExceptionCode::illegal_data_value);
+    CHECK(zero.local.refusal == protocol::GatewayRefusal::bad_value);
     const Classified short_write = classify(Bytes{0x10, 0x08, 0x83, 0x00, 0x02, 0x04, 0x00});
     CHECK_FALSE(short_write.request);
-    CHECK(short_write.local.code == protocol::ExceptionCode::illegal_data_value);
+    CHECK(short_write.local.refusal == protocol::GatewayRefusal::bad_value);
+}
+
+TEST_CASE("each resource is named with the registers of its block (r6_sequences)") {
+    CHECK(to_string(Resource::counter_read) == "counter read (0x0883-0x0888)");
+    CHECK(to_string(Resource::source_view) == "data-source view (0x7530-0x7531)");
+    CHECK(to_string(Resource::source_upload) == "data-source upload (0x7532-0x9C40)");
 }
