@@ -158,7 +158,6 @@ void LineCore::on(TimePoint now, line_event::Opened& event, LineStep& step) {
     port_ = PortState::up;
     open_attempts_ = 0;
     reopen_delay_ = config_.reopen_initial;
-    scheduler_.set_line_up(true, now);
     step.watch_readable = true;
     step.line_up = true;
     request_drive(step);
@@ -172,7 +171,7 @@ void LineCore::on(TimePoint now, line_event::OpenFailed& event, LineStep& step) 
         reopen_delay_ = config_.reopen_initial;
         log_(LogLevel::error, "line " + config_.name + ": cannot open " + port_path_ + ": " + event.what +
                                   "; check the adapter and its cable; retrying in " + duration_text(reopen_delay_));
-        scheduler_.set_line_up(false, now);
+        scheduler_.cancel_all(OutcomeStatus::line_down, now);
         step.line_up = false;
     } else {
         reopen_delay_ = std::min(reopen_delay_ * 2, config_.reopen_max);
@@ -212,7 +211,9 @@ void LineCore::port_failed(TimePoint now, const char* operation, const std::stri
     if (auto finished = master_.abort(now)) {
         scheduler_.finished(std::move(finished->transaction), finished->outcome, now);
     }
-    scheduler_.set_line_up(false, now);
+    // Queued requests fail now (a read the abort re-queued for its retry included);
+    // take_inbox() turns later submissions away until the port is open again.
+    scheduler_.cancel_all(OutcomeStatus::line_down, now);
     step.line_up = false;
     schedule_reopen(now, step);
 }
@@ -314,7 +315,15 @@ void LineCore::begin_drive(TimePoint now, bool polled, LineStep& step) {
 }
 
 void LineCore::take_inbox(TimePoint now) {
-    for (Transaction& transaction : inbox_) scheduler_.submit(std::move(transaction), now);
+    // The port's state is the core's alone: while it is down, submissions complete
+    // `line_down`; before the first open they queue.
+    for (Transaction& transaction : inbox_) {
+        if (port_ == PortState::down) {
+            scheduler_.turn_away(std::move(transaction), OutcomeStatus::line_down, now);
+        } else {
+            scheduler_.submit(std::move(transaction), now);
+        }
+    }
     inbox_.clear();
 }
 

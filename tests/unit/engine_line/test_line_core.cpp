@@ -263,6 +263,13 @@ TEST_CASE("line core: the port fails with work in flight; it all completes line_
                                            "retrying in 100 ms"));
     REQUIRE(line.reopen_at == line.now + 100ms);
 
+    // The core's port state alone decides: while it is down a submission completes
+    // line_down (from the drive) and is counted as the device's outcome.
+    line.submit(read_tx(1, 2, Priority::poll), "while-down");
+    line.advance(0ms);
+    CHECK(line.recorder.status("while-down") == OutcomeStatus::line_down);
+    CHECK(line.core.scheduler().stats(1)->of(Priority::poll).outcome(OutcomeStatus::line_down) == 2);
+
     line.read_failure.reset();
     line.advance(100ms);
     CHECK(line.core.line_up());
@@ -273,7 +280,7 @@ TEST_CASE("line core: the port fails with work in flight; it all completes line_
     CHECK(line.take_written() == read_request);
     line.arrive(reply_1());
     CHECK(line.recorder.status("after") == OutcomeStatus::ok);
-    CHECK(line.recorder.total() == 3);
+    CHECK(line.recorder.total() == 4);
 }
 
 TEST_CASE("line core: stop completes everything cancelled exactly once; later submissions too") {
