@@ -33,6 +33,7 @@ const char* question_text(LineNext next) noexcept {
         case LineNext::none: return "nothing";
         case LineNext::resume: return "resume";
         case LineNext::tick: return "tick";
+        case LineNext::spin: return "spin";
         case LineNext::open: return "open";
         case LineNext::read: return "read";
         case LineNext::write: return "write";
@@ -287,6 +288,15 @@ void LineCore::on(TimePoint, line_event::WriteBlocked& event, LineStep& step) {
 }
 
 void LineCore::on(TimePoint now, line_event::Resume&, LineStep& step) {
+    if (asked_ == LineNext::spin) {
+        // The spin reached the instant. The reactor has not looked at the port during
+        // it: the drive reads it before the write (polled false), so a byte that came
+        // meanwhile still pushes the silence out.
+        asked_ = LineNext::none;
+        polled_ = false;
+        drive(now, step);
+        return;
+    }
     const LineNext question = asked_;
     if (!answered(LineNext::resume, LineNext::tick, "Resume")) return;
     if (question == LineNext::tick) {
@@ -295,7 +305,7 @@ void LineCore::on(TimePoint now, line_event::Resume&, LineStep& step) {
         if (wait_until_ <= now) {
             drive(now, step);
         } else {
-            arm_wake(wait_until_, now, step);
+            wait_for(wait_until_, now, step);
         }
         return;
     }
@@ -397,6 +407,27 @@ void LineCore::drive(TimePoint now, LineStep& step) {
         arm_wake(*wake > now ? *wake : now + std::chrono::milliseconds{1}, now, step);
         return;
     }
+}
+
+/// Precise silence timing (config_.spin_lead > 0): a request waiting for its silence
+/// is already picked and encoded (the master started it when the line became free, so
+/// the scheduling rules are those of the instant it was picked, as without the
+/// spin). The exact timer wakes the drive spin_lead before the instant, which covers
+/// the timer's own lateness; from there the shell spins to the instant, and the drive
+/// reads the port and writes. Every other wait (replies, polls, broadcasts settling)
+/// is left to the timers.
+void LineCore::wait_for(TimePoint until, TimePoint now, LineStep& step) {
+    const Duration lead = config_.spin_lead;
+    if (lead <= Duration::zero() || master_.state() != MasterState::waiting_silence) {
+        arm_wake(until, now, step);
+        return;
+    }
+    if (until - now <= lead) {
+        step.spin_until = until;
+        ask(LineNext::spin, step);
+        return;
+    }
+    arm_wake(until - lead, now, step);
 }
 
 /// Wakes the drive at @p until (or earlier: the drive always looks again). Short waits

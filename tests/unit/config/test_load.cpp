@@ -174,6 +174,7 @@ upstreams:
     CHECK(line.byte_timeout == 5ms);
     CHECK(line.turnaround == 0ms);
     CHECK(line.broadcast_delay == 100ms);
+    CHECK_FALSE(line.precise_timing);
     CHECK(line.read_retries == 1);
     CHECK(line.offline_after == 3);
     CHECK(line.offline_backoff == Backoff{1s, 30s});
@@ -282,6 +283,7 @@ lines:
     stop_bits: 2
     rs485: {enabled: true, rts_on_send: false, rts_after_send: true, delay_before_send: 1ms, delay_after_send: 2ms}
     local_echo: true
+    precise_timing: true
     read_retries: 0
     devices:
       - {name: m, type: modbus, address: 0x10, unit_id: 0x20,
@@ -301,6 +303,7 @@ lines:
     CHECK(line.bits_per_character() == 11);
     CHECK(line.rs485 == Rs485Config{true, false, true, 1ms, 2ms});
     CHECK(line.local_echo);
+    CHECK(line.precise_timing);
     CHECK(line.read_retries == 0);
     const auto& device = line.devices.at(0);
     CHECK(device.address == BusAddress{0x10});
