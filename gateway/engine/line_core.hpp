@@ -51,11 +51,6 @@
 
 namespace fieldbridge::engine {
 
-/// The spin lead of precise silence timing (config `precise_timing: true`): longer than
-/// a timer wake-up is late on the machines measured (50-150 us on the development VM,
-/// docs/configuration.md), so the spin, not the timer, decides the instant.
-inline constexpr Duration precise_timing_lead = std::chrono::microseconds{200};
-
 struct LineCoreConfig {
     std::string name;  ///< the line's config name, for logs
     LineTimingConfig timing;
@@ -64,7 +59,10 @@ struct LineCoreConfig {
     Duration reopen_max = std::chrono::seconds{30};
     /// Precise silence timing: a request waiting for its silence (or turnaround) is
     /// woken this long before the instant and the shell spins to it (LineNext::spin);
-    /// zero: the exact timer is set to the instant itself.
+    /// zero: the exact timer is set to the instant itself. The daemon's lead is
+    /// config::LineConfig::precise_timing_lead, longer than a timer wake-up is late on
+    /// the machines measured (50-150 us on the development VM), so the spin, not the
+    /// timer, decides the instant.
     Duration spin_lead = Duration::zero();
 };
 

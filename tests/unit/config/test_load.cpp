@@ -266,6 +266,24 @@ lines:
     CHECK(config->lines.at(2).bits_per_character() == 10);
 }
 
+TEST_CASE("precise_timing default: on when the whole silence is shorter than the spin lead") {
+    const auto config = load_ok(R"(
+gateway: {id: t}
+lines:
+  - {name: a, port: /dev/ttyS0, baud: 115200}
+  - {name: b, port: /dev/ttyS1, baud: 230400}
+  - {name: c, port: /dev/ttyS2, baud: 921600}
+  - {name: d, port: /dev/ttyS3, baud: 921600, turnaround: 1ms}
+  - {name: e, port: /dev/ttyS4, baud: 921600, precise_timing: false}
+)");
+    REQUIRE(config);
+    CHECK_FALSE(config->lines.at(0).precise_timing);  // 3.5 characters: 304 us
+    CHECK(config->lines.at(1).precise_timing);        // 152 us
+    CHECK(config->lines.at(2).precise_timing);        // 38 us
+    CHECK_FALSE(config->lines.at(3).precise_timing);  // the turnaround gates: 1 ms
+    CHECK_FALSE(config->lines.at(4).precise_timing);
+}
+
 TEST_CASE("explicit values override defaults; integers in hex; IPv6 listen") {
     const auto config = load_ok(R"(
 gateway: {id: t, log_level: debug}
