@@ -115,6 +115,7 @@ void set(T& target, const Field<T>& field) {
     line.byte_timeout = raw.byte_timeout.value_or(default_byte_timeout(line));
     set(line.turnaround, raw.turnaround);
     set(line.broadcast_delay, raw.broadcast_delay);
+    line.precise_timing = raw.precise_timing.value_or(default_precise_timing(line));
     line.read_retries = narrow<unsigned>(raw.read_retries, line.read_retries);
     line.offline_after = narrow<unsigned>(raw.offline_after, line.offline_after);
     line.offline_backoff = build_backoff(raw.offline_backoff, line.offline_backoff);

@@ -221,6 +221,13 @@ struct LineConfig {
     /// (Modbus over Serial Line V1.02, 2.4.1: "turnaround delay", typically 100-200 ms).
     milliseconds broadcast_delay{100};
     static constexpr Range<milliseconds> broadcast_delay_range{milliseconds{0}, seconds{10}};
+    /// Precise silence timing: the worker wakes precise_timing_lead before a request's
+    /// silence ends and spins the last stretch on the loop thread, so the request
+    /// leaves at the instant instead of when a timer wake-up gets round to it (line
+    /// rate for CPU: docs/configuration.md). When absent from the file: true when the
+    /// whole silence is shorter than the lead (spun without a timer), else false.
+    bool precise_timing = false;
+    static constexpr std::chrono::microseconds precise_timing_lead{200};
     unsigned read_retries = 1;  ///< writes are never retried (spec section 3 rule 6)
     static constexpr Range<std::int64_t> read_retries_range{0, 5};
     unsigned offline_after = 3;  ///< consecutive timeouts

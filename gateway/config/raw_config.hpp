@@ -146,6 +146,7 @@ struct RawLine : RawNode {
     Field<std::chrono::milliseconds> byte_timeout;
     Field<std::chrono::milliseconds> turnaround;
     Field<std::chrono::milliseconds> broadcast_delay;
+    Field<bool> precise_timing;
     Field<std::int64_t> read_retries;
     Field<std::int64_t> offline_after;
     RawBackoff offline_backoff;

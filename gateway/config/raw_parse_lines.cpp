@@ -66,7 +66,7 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
 RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "port", "baud", "parity", "data_bits", "stop_bits", "rs485", "local_echo",
-                         "response_timeout", "byte_timeout", "turnaround", "broadcast_delay", "read_retries", "offline_after",
+                         "response_timeout", "byte_timeout", "turnaround", "broadcast_delay", "precise_timing", "read_retries", "offline_after",
                          "offline_backoff", "broadcast_unit", "broadcast_share", "devices"},
                         sink);
     RawLine raw;
@@ -83,6 +83,7 @@ RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     raw.byte_timeout = read_duration(map, "byte_timeout");
     raw.turnaround = read_duration(map, "turnaround");
     raw.broadcast_delay = read_duration(map, "broadcast_delay");
+    raw.precise_timing = read_bool(map, "precise_timing");
     raw.read_retries = read_int(map, "read_retries");
     raw.offline_after = read_int(map, "offline_after");
     raw.offline_backoff = parse_backoff(map.child("offline_backoff"), sink);

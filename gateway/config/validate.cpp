@@ -46,6 +46,13 @@ std::chrono::milliseconds default_byte_timeout(const LineConfig& framing) {
     return std::max(LineConfig::default_byte_timeout, character_times(framing, 3.5));
 }
 
+bool default_precise_timing(const LineConfig& line) {
+    // Measured (docs/configuration.md): a spun silence without a timer costs no more
+    // CPU than the timer's wake-ups; a timer plus a spin costs up to the lead.
+    return line.turnaround == std::chrono::milliseconds{0} &&
+           line.character_time() * 7 / 2 < LineConfig::precise_timing_lead;
+}
+
 std::string framing_name(const LineConfig& framing) {
     const char parity = framing.parity == Parity::none ? 'N' : (framing.parity == Parity::even ? 'E' : 'O');
     return std::to_string(framing.data_bits) + parity + std::to_string(framing.stop_bits);

@@ -39,6 +39,10 @@ void validate_uniqueness(const RawConfig& raw, DiagnosticSink& sink);  // valida
 /// The byte_timeout used when the file does not set one: 5ms, or 3.5 character
 /// times when that is longer.
 [[nodiscard]] std::chrono::milliseconds default_byte_timeout(const LineConfig& framing);
+/// The precise_timing used when the file does not set one: true when the silence
+/// before a request (3.5 characters; the turnaround when one is set) is shorter than
+/// LineConfig::precise_timing_lead, so that it is spun whole, without a timer.
+[[nodiscard]] bool default_precise_timing(const LineConfig& line);
 /// "8N1", "7E2"...
 [[nodiscard]] std::string framing_name(const LineConfig& framing);
 

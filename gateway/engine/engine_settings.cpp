@@ -44,6 +44,7 @@ LineWorkerConfig line_worker_config(const config::LineConfig& line) {
     // we knock on something that is not there".
     worker.reopen_initial = line.offline_backoff.initial;
     worker.reopen_max = line.offline_backoff.max;
+    worker.spin_lead = line.precise_timing ? Duration{config::LineConfig::precise_timing_lead} : Duration::zero();
     return worker;
 }
 

@@ -33,6 +33,7 @@ const char* question_text(LineNext next) noexcept {
         case LineNext::none: return "nothing";
         case LineNext::resume: return "resume";
         case LineNext::tick: return "tick";
+        case LineNext::spin: return "spin";
         case LineNext::open: return "open";
         case LineNext::read: return "read";
         case LineNext::write: return "write";
@@ -158,7 +159,6 @@ void LineCore::on(TimePoint now, line_event::Opened& event, LineStep& step) {
     port_ = PortState::up;
     open_attempts_ = 0;
     reopen_delay_ = config_.reopen_initial;
-    scheduler_.set_line_up(true, now);
     step.watch_readable = true;
     step.line_up = true;
     request_drive(step);
@@ -172,7 +172,7 @@ void LineCore::on(TimePoint now, line_event::OpenFailed& event, LineStep& step) 
         reopen_delay_ = config_.reopen_initial;
         log_(LogLevel::error, "line " + config_.name + ": cannot open " + port_path_ + ": " + event.what +
                                   "; check the adapter and its cable; retrying in " + duration_text(reopen_delay_));
-        scheduler_.set_line_up(false, now);
+        scheduler_.cancel_all(OutcomeStatus::line_down, now);
         step.line_up = false;
     } else {
         reopen_delay_ = std::min(reopen_delay_ * 2, config_.reopen_max);
@@ -212,7 +212,9 @@ void LineCore::port_failed(TimePoint now, const char* operation, const std::stri
     if (auto finished = master_.abort(now)) {
         scheduler_.finished(std::move(finished->transaction), finished->outcome, now);
     }
-    scheduler_.set_line_up(false, now);
+    // Queued requests fail now (a read the abort re-queued for its retry included);
+    // take_inbox() turns later submissions away until the port is open again.
+    scheduler_.cancel_all(OutcomeStatus::line_down, now);
     step.line_up = false;
     schedule_reopen(now, step);
 }
@@ -286,6 +288,15 @@ void LineCore::on(TimePoint, line_event::WriteBlocked& event, LineStep& step) {
 }
 
 void LineCore::on(TimePoint now, line_event::Resume&, LineStep& step) {
+    if (asked_ == LineNext::spin) {
+        // The spin reached the instant. The reactor has not looked at the port during
+        // it: the drive reads it before the write (polled false), so a byte that came
+        // meanwhile still pushes the silence out.
+        asked_ = LineNext::none;
+        polled_ = false;
+        drive(now, step);
+        return;
+    }
     const LineNext question = asked_;
     if (!answered(LineNext::resume, LineNext::tick, "Resume")) return;
     if (question == LineNext::tick) {
@@ -294,7 +305,7 @@ void LineCore::on(TimePoint now, line_event::Resume&, LineStep& step) {
         if (wait_until_ <= now) {
             drive(now, step);
         } else {
-            arm_wake(wait_until_, now, step);
+            wait_for(wait_until_, now, step);
         }
         return;
     }
@@ -314,7 +325,15 @@ void LineCore::begin_drive(TimePoint now, bool polled, LineStep& step) {
 }
 
 void LineCore::take_inbox(TimePoint now) {
-    for (Transaction& transaction : inbox_) scheduler_.submit(std::move(transaction), now);
+    // The port's state is the core's alone: while it is down, submissions complete
+    // `line_down`; before the first open they queue.
+    for (Transaction& transaction : inbox_) {
+        if (port_ == PortState::down) {
+            scheduler_.turn_away(std::move(transaction), OutcomeStatus::line_down, now);
+        } else {
+            scheduler_.submit(std::move(transaction), now);
+        }
+    }
     inbox_.clear();
 }
 
@@ -388,6 +407,27 @@ void LineCore::drive(TimePoint now, LineStep& step) {
         arm_wake(*wake > now ? *wake : now + std::chrono::milliseconds{1}, now, step);
         return;
     }
+}
+
+/// Precise silence timing (config_.spin_lead > 0): a request waiting for its silence
+/// is already picked and encoded (the master started it when the line became free, so
+/// the scheduling rules are those of the instant it was picked, as without the
+/// spin). The exact timer wakes the drive spin_lead before the instant, which covers
+/// the timer's own lateness; from there the shell spins to the instant, and the drive
+/// reads the port and writes. Every other wait (replies, polls, broadcasts settling)
+/// is left to the timers.
+void LineCore::wait_for(TimePoint until, TimePoint now, LineStep& step) {
+    const Duration lead = config_.spin_lead;
+    if (lead <= Duration::zero() || master_.state() != MasterState::waiting_silence) {
+        arm_wake(until, now, step);
+        return;
+    }
+    if (until - now <= lead) {
+        step.spin_until = until;
+        ask(LineNext::spin, step);
+        return;
+    }
+    arm_wake(until - lead, now, step);
 }
 
 /// Wakes the drive at @p until (or earlier: the drive always looks again). Short waits

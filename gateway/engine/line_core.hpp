@@ -19,13 +19,16 @@
 ///     next        open the port -> Opened / OpenFailed; read it once -> BytesRead /
 ///                 PortFailed; write these bytes -> Written / WriteBlocked /
 ///                 PortFailed; resume (after the deliveries) or tick (with a fresh
-///                 `now`) -> Resume
+///                 `now`) -> Resume; spin (busy-wait until `spin_until`, then a
+///                 `now` at or after it) -> Resume
 ///
 /// The drive loop (what the old LineWorker::drive() did): take the inbox into the
 /// scheduler; pick the next transaction when the master is free; read the port before
 /// a write or a timeout decision unless the reactor just looked at it (`polled`);
 /// hand out the master's write; wait for its deadline (short waits on the exact
-/// timer, long ones on a lazy timer that may wake early: arm_wake); and when nothing
+/// timer, long ones on a lazy timer that may wake early: arm_wake; with a spin lead,
+/// the silence before a request ends in a spin: the request, already picked and
+/// encoded, is written within microseconds of the instant); and when nothing
 /// is eligible, wait for the scheduler's next wake-up or a submission. Completions
 /// are delivered before the next transaction is picked, so a handler's submission
 /// competes for it, as before.
@@ -54,6 +57,13 @@ struct LineCoreConfig {
     SchedulerConfig scheduler;
     Duration reopen_initial = std::chrono::milliseconds{500};
     Duration reopen_max = std::chrono::seconds{30};
+    /// Precise silence timing: a request waiting for its silence (or turnaround) is
+    /// woken this long before the instant and the shell spins to it (LineNext::spin);
+    /// zero: the exact timer is set to the instant itself. The daemon's lead is
+    /// config::LineConfig::precise_timing_lead, longer than a timer wake-up is late on
+    /// the machines measured (50-150 us on the development VM), so the spin, not the
+    /// timer, decides the instant.
+    Duration spin_lead = Duration::zero();
 };
 
 /// The shell's two wake timers (LineCore::arm_wake).
@@ -124,12 +134,12 @@ using LineEvent =
                  line_event::Written, line_event::WriteBlocked, line_event::PortFailed, line_event::Resume>;
 
 /// The one answer a step waits for (see the file comment).
-enum class LineNext : std::uint8_t { none, resume, tick, open, read, write };
+enum class LineNext : std::uint8_t { none, resume, tick, spin, open, read, write };
 
 /// What the shell does after one transition, in this order: the effects, the
-/// deliveries (LineDelivery), `line_up`, then `next`. `next` is open, read or write only
-/// in a step with nothing to deliver, so no handler runs between the question and
-/// its answer.
+/// deliveries (LineDelivery), `line_up`, then `next`. `next` is spin, open, read or
+/// write only in a step with nothing to deliver, so no handler runs between the
+/// question and its answer.
 struct LineStep {
     bool close_port = false;
     bool cancel_timers = false;  ///< the wake timers and the reopen timer
@@ -142,6 +152,9 @@ struct LineStep {
     std::optional<bool> line_up;  ///< the line went up / down: tell its owner
     LineNext next = LineNext::none;
     protocol::ByteView write;  ///< next == write: valid until the next event
+    /// next == spin: busy-wait (no sleep, no reactor) until the clock reaches this
+    /// instant, at most the spin lead after the step's `now`; then Resume.
+    TimePoint spin_until{};
 };
 
 class LineCore {
@@ -207,6 +220,8 @@ private:
     void drive(TimePoint now, LineStep& step);
     void take_inbox(TimePoint now);
     void arm_wake(TimePoint until, TimePoint now, LineStep& step);
+    /// The tick's deadline is in the future: spin to it, or set a wake timer.
+    void wait_for(TimePoint until, TimePoint now, LineStep& step);
     void port_failed(TimePoint now, const char* operation, const std::string& what, LineStep& step);
     void schedule_reopen(TimePoint now, LineStep& step);
 

@@ -181,6 +181,12 @@ void LineScheduler::refuse(Transaction transaction, OutcomeStatus status, TimePo
     completions_.push_back(LineCompletion{std::move(transaction), std::move(outcome)});
 }
 
+void LineScheduler::turn_away(Transaction transaction, OutcomeStatus status, TimePoint now) {
+    transaction.id = ++next_id_;
+    transaction.enqueued = now;
+    reject(std::move(transaction), status, now);
+}
+
 void LineScheduler::complete(Transaction transaction, const Outcome& outcome) {
     if (Device* device = find(transaction.device)) {
         ++device->stats.by_class[class_index(transaction.priority)].outcomes[static_cast<std::size_t>(outcome.status)];
@@ -215,10 +221,6 @@ void LineScheduler::enqueue(Device& device, Transaction transaction, TimePoint n
 void LineScheduler::submit(Transaction transaction, TimePoint now) {
     transaction.id = ++next_id_;
     transaction.enqueued = now;
-    if (!line_up_) {
-        reject(std::move(transaction), OutcomeStatus::line_down, now);
-        return;
-    }
     Device* device = find(transaction.device);
     if (device == nullptr && is_broadcast(transaction)) {
         Device pseudo;
@@ -411,14 +413,6 @@ void LineScheduler::cancel_all(OutcomeStatus status, TimePoint now) {
         }
         device.queue.clear();
     }
-}
-
-void LineScheduler::set_line_up(bool up, TimePoint now) {
-    if (line_up_ == up) return;
-    line_up_ = up;
-    log_(up ? LogLevel::info : LogLevel::warning,
-         "line " + config_.line_name + (up ? ": port open, scheduling" : ": port down, queued requests fail"));
-    if (!up) cancel_all(OutcomeStatus::line_down, now);
 }
 
 bool LineScheduler::has_device(DeviceIndex device) const noexcept { return find(device) != nullptr; }

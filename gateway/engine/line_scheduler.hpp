@@ -148,7 +148,7 @@ public:
     void remove_device(DeviceIndex device, OutcomeStatus status, TimePoint now);
 
     /// Queues @p transaction (sets id and enqueued), or completes it at once:
-    /// `line_down` while the line is down, `invalid_request` for an unknown device,
+    /// `invalid_request` for an unknown device,
     /// `expired` past its deadline, `device_offline` (see above), `queue_full` beyond
     /// the device's queue_limit (Modbus TCP: exception 0x06).
     void submit(Transaction transaction, TimePoint now);
@@ -165,6 +165,11 @@ public:
     /// at shutdown). Not counted in the device's statistics.
     void refuse(Transaction transaction, OutcomeStatus status, TimePoint now);
 
+    /// A submission the line turns away (its port is down: `line_down`): completed at
+    /// once like a refusal of submit() (id and enqueued set, counted in the device's
+    /// outcomes). The scheduler keeps no port state: the line core owns it.
+    void turn_away(Transaction transaction, OutcomeStatus status, TimePoint now);
+
     /// When next() may have something to hand out while nothing is submitted: now if
     /// something is eligible, else the earliest probe time or deadline; nullopt when
     /// all queues are empty.
@@ -175,11 +180,6 @@ public:
 
     /// Completes every queued transaction with @p status (shutdown, reconfiguration).
     void cancel_all(OutcomeStatus status, TimePoint now);
-
-    /// Port state. Down: the queues are completed `line_down` and so is every submit
-    /// until it is up again.
-    void set_line_up(bool up, TimePoint now);
-    [[nodiscard]] bool line_up() const noexcept { return line_up_; }
 
     /// Completions decided since the last take, in order, appended to @p into (swapped
     /// when @p into is empty: the two buffers keep their capacity, no allocation).
@@ -242,7 +242,6 @@ private:
     std::map<DeviceIndex, Device> devices_;
     std::vector<LineCompletion> completions_;  ///< collected, for take_completions()
     std::vector<HealthChange> health_;         ///< collected, for take_health_changes()
-    bool line_up_ = true;
     std::uint64_t next_id_ = 0;
     std::uint64_t next_sequence_ = 0;
     std::size_t consecutive_commands_ = 0;

@@ -101,6 +101,10 @@ private:
                 case LineNext::none: return;
                 case LineNext::resume:
                 case LineNext::tick: event = line_event::Resume{}; break;
+                case LineNext::spin:
+                    spin_until(step.spin_until);
+                    event = line_event::Resume{};
+                    break;
                 case LineNext::open: event = open(); break;
                 case LineNext::read: event = read(); break;
                 case LineNext::write: event = write(step.write); break;
@@ -146,6 +150,18 @@ private:
     }
 
     // ---- the answers to the core's questions ------------------------------------------
+
+    /// Precise silence timing: the loop thread busy-waits the last stretch of a
+    /// silence (at most the core's spin lead), so the request leaves at the instant
+    /// rather than when a timer wake-up gets round to it. Nothing else on the loop
+    /// runs meanwhile.
+    void spin_until(TimePoint until) const noexcept {
+        while (seams_.now() < until) {
+#if defined(__x86_64__) || defined(__i386__)
+            __builtin_ia32_pause();
+#endif
+        }
+    }
 
     LineEvent open() {
         try {

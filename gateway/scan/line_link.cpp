@@ -94,6 +94,12 @@ void LineLink::feed(engine::LineEvent&& event) {
             case engine::LineNext::tick:
                 event = line_event::Resume{};
                 break;
+            case engine::LineNext::spin:
+                // Only with a spin lead, which the scan does not set: busy-wait anyway.
+                while (Clock::now() < step.spin_until) {
+                }
+                event = line_event::Resume{};
+                break;
             case engine::LineNext::open:
                 // The caller opened the port: the scan needs it to itself and says so
                 // before the link exists. A failure here is the caller's to report.

@@ -99,13 +99,17 @@ private:
 std::string engine_yaml(const std::string& port) {
     // Polls slowed down so that (a) measures the on-demand reads alone; max_age 0: every
     // read goes to the line; a queue long enough for the readers and the writes.
+    // FIELDBRIDGE_BENCH_PRECISE_TIMING=true|false sets the line's precise_timing
+    // (docs/configuration.md); unset: the default.
+    const char* precise = std::getenv("FIELDBRIDGE_BENCH_PRECISE_TIMING");
+    const std::string precise_line = precise != nullptr ? fmt::format("\n    precise_timing: {}", precise) : "";
     return fmt::format(R"(
 gateway: {{ id: bench-line }}
 lines:
   - name: line-a
     port: {}
     baud: 115200
-    turnaround: 0ms
+    turnaround: 0ms{}
     devices:
       - name: xeg
         type: hiwin-xeg
@@ -116,7 +120,7 @@ lines:
         command_ttl: 1s
         poll: {{ fast: 60min, slow: 60min, motion: 60min }}
 )",
-                       port);
+                       port, precise_line);
 }
 
 int run(double run_seconds, int write_count) {

@@ -174,6 +174,7 @@ upstreams:
     CHECK(line.byte_timeout == 5ms);
     CHECK(line.turnaround == 0ms);
     CHECK(line.broadcast_delay == 100ms);
+    CHECK_FALSE(line.precise_timing);
     CHECK(line.read_retries == 1);
     CHECK(line.offline_after == 3);
     CHECK(line.offline_backoff == Backoff{1s, 30s});
@@ -265,6 +266,24 @@ lines:
     CHECK(config->lines.at(2).bits_per_character() == 10);
 }
 
+TEST_CASE("precise_timing default: on when the whole silence is shorter than the spin lead") {
+    const auto config = load_ok(R"(
+gateway: {id: t}
+lines:
+  - {name: a, port: /dev/ttyS0, baud: 115200}
+  - {name: b, port: /dev/ttyS1, baud: 230400}
+  - {name: c, port: /dev/ttyS2, baud: 921600}
+  - {name: d, port: /dev/ttyS3, baud: 921600, turnaround: 1ms}
+  - {name: e, port: /dev/ttyS4, baud: 921600, precise_timing: false}
+)");
+    REQUIRE(config);
+    CHECK_FALSE(config->lines.at(0).precise_timing);  // 3.5 characters: 304 us
+    CHECK(config->lines.at(1).precise_timing);        // 152 us
+    CHECK(config->lines.at(2).precise_timing);        // 38 us
+    CHECK_FALSE(config->lines.at(3).precise_timing);  // the turnaround gates: 1 ms
+    CHECK_FALSE(config->lines.at(4).precise_timing);
+}
+
 TEST_CASE("explicit values override defaults; integers in hex; IPv6 listen") {
     const auto config = load_ok(R"(
 gateway: {id: t, log_level: debug}
@@ -282,6 +301,7 @@ lines:
     stop_bits: 2
     rs485: {enabled: true, rts_on_send: false, rts_after_send: true, delay_before_send: 1ms, delay_after_send: 2ms}
     local_echo: true
+    precise_timing: true
     read_retries: 0
     devices:
       - {name: m, type: modbus, address: 0x10, unit_id: 0x20,
@@ -301,6 +321,7 @@ lines:
     CHECK(line.bits_per_character() == 11);
     CHECK(line.rs485 == Rs485Config{true, false, true, 1ms, 2ms});
     CHECK(line.local_echo);
+    CHECK(line.precise_timing);
     CHECK(line.read_retries == 0);
     const auto& device = line.devices.at(0);
     CHECK(device.address == BusAddress{0x10});

@@ -182,12 +182,14 @@ lines:
     stop_bits: 3
     parity: mark
     rs485: {delay_before_send: 2s}
+    precise_timing: spin
 )";
     CHECK_REPORTS(yaml, "lines[0].baud", 5, 11, "115000 is not a standard rate", "9600, 19200");
     CHECK_REPORTS(yaml, "lines[0].data_bits", 6, 16, "expected 7 or 8");
     CHECK_REPORTS(yaml, "lines[0].stop_bits", 7, 16, "expected 1 or 2");
     CHECK_REPORTS(yaml, "lines[0].parity", 8, 13, "expected one of: none, even, odd");
     CHECK_REPORTS(yaml, "lines[0].rs485.delay_before_send", 9, 32, "expected 0ms..1s");
+    CHECK_REPORTS(yaml, "lines[0].precise_timing", 10, 21, "'spin' is not a boolean; expected true or false");
 
     CHECK_REPORTS("gateway: {id: t}\nlines: [{name: a, port: ttyS0}]\n", "lines[0].port", 2, 25,
                   "not an absolute path");

@@ -174,13 +174,12 @@ public:
         scheduler_.cancel_all(status, now);
         deliver();
     }
-    void set_line_up(bool up, TimePoint now) {
-        scheduler_.set_line_up(up, now);
+    void turn_away(Transaction transaction, fe::OutcomeStatus status, TimePoint now) {
+        scheduler_.turn_away(std::move(transaction), status, now);
         deliver();
     }
 
     [[nodiscard]] std::optional<TimePoint> next_wakeup(TimePoint now) const { return scheduler_.next_wakeup(now); }
-    [[nodiscard]] bool line_up() const noexcept { return scheduler_.line_up(); }
     [[nodiscard]] bool has_device(fe::DeviceIndex device) const noexcept { return scheduler_.has_device(device); }
     [[nodiscard]] bool online(fe::DeviceIndex device) const noexcept { return scheduler_.online(device); }
     [[nodiscard]] const fe::DeviceStats* stats(fe::DeviceIndex device) const noexcept {

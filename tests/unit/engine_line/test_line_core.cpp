@@ -68,6 +68,16 @@ struct FakeLine {
                 case fe::LineNext::none: return;
                 case fe::LineNext::resume:
                 case fe::LineNext::tick: event = ev::Resume{}; break;
+                case fe::LineNext::spin:
+                    // The clock seam runs on while the shell spins; bytes may arrive.
+                    ++spins;
+                    REQUIRE(step.spin_until > now);
+                    REQUIRE(step.spin_until - now <= core.config().spin_lead);
+                    now = step.spin_until;
+                    for (Bytes& bytes : arrive_during_spin) input.push_back(std::move(bytes));
+                    arrive_during_spin.clear();
+                    event = ev::Resume{};
+                    break;
                 case fe::LineNext::open:
                     if (open_failure) {
                         event = ev::OpenFailed{*open_failure};
@@ -161,6 +171,8 @@ struct FakeLine {
     std::optional<std::string> open_failure;
     std::optional<std::string> read_failure;
     TimePoint last_write_at{};
+    std::vector<Bytes> arrive_during_spin;  ///< in the port's buffer once the next spin ends
+    unsigned spins = 0;
     unsigned reads = 0;
     unsigned closes = 0;
     unsigned exact_sets = 0;
@@ -263,6 +275,13 @@ TEST_CASE("line core: the port fails with work in flight; it all completes line_
                                            "retrying in 100 ms"));
     REQUIRE(line.reopen_at == line.now + 100ms);
 
+    // The core's port state alone decides: while it is down a submission completes
+    // line_down (from the drive) and is counted as the device's outcome.
+    line.submit(read_tx(1, 2, Priority::poll), "while-down");
+    line.advance(0ms);
+    CHECK(line.recorder.status("while-down") == OutcomeStatus::line_down);
+    CHECK(line.core.scheduler().stats(1)->of(Priority::poll).outcome(OutcomeStatus::line_down) == 2);
+
     line.read_failure.reset();
     line.advance(100ms);
     CHECK(line.core.line_up());
@@ -273,7 +292,7 @@ TEST_CASE("line core: the port fails with work in flight; it all completes line_
     CHECK(line.take_written() == read_request);
     line.arrive(reply_1());
     CHECK(line.recorder.status("after") == OutcomeStatus::ok);
-    CHECK(line.recorder.total() == 3);
+    CHECK(line.recorder.total() == 4);
 }
 
 TEST_CASE("line core: stop completes everything cancelled exactly once; later submissions too") {
@@ -467,6 +486,100 @@ TEST_CASE("line core: an answer nobody asked for is a shell bug") {
     line.start();
     line.submit(read_tx(0, 1, Priority::poll), "poll");
     CHECK_THROWS_AS(line.feed(ev::BytesRead{}), std::logic_error);
+}
+
+// ---- precise silence timing ------------------------------------------------------
+
+fe::LineCoreConfig precise(std::uint32_t baud = 115200) {
+    fe::LineCoreConfig config = FakeLine::named("L");
+    config.timing.baud = baud;
+    config.spin_lead = 200us;
+    return config;
+}
+
+TEST_CASE("line core: precise timing wakes the spin lead before the silence ends and writes at the instant") {
+    FakeLine line(precise());
+    line.start();
+    const fe::Duration t3_5 = line.core.master().timing().t3_5();  // 304 us at 115200
+    REQUIRE(t3_5 > 200us);
+    line.submit(read_tx(0, 1, Priority::poll), "first");
+    line.advance(0ms);
+    // Picked and encoded when the line became free; the timer is set the lead early.
+    REQUIRE(line.exact_at == t0 + t3_5 - 200us);
+    CHECK(line.core.master().state() == fe::MasterState::waiting_silence);
+    CHECK(line.spins == 0);
+    line.advance_to(t0 + t3_5 - 200us);
+    CHECK(line.spins == 1);
+    CHECK(line.last_write_at == t0 + t3_5);  // the spin's end, not a timer's
+    CHECK(line.take_written() == read_request);
+
+    // After the reply: the next request, already queued, the same way.
+    line.submit(read_tx(1, 2, Priority::poll), "second");
+    line.advance(1ms);
+    const TimePoint reply_at = line.now;
+    line.arrive(reply_1());
+    CHECK(line.recorder.status("first") == OutcomeStatus::ok);
+    CHECK(line.exact_at == reply_at + t3_5 - 200us);
+    line.advance_to(reply_at + t3_5);
+    CHECK(line.spins == 2);
+    CHECK(line.last_write_at == reply_at + t3_5);
+    CHECK_FALSE(line.take_written().empty());
+}
+
+TEST_CASE("line core: without precise timing the exact timer is set to the instant and nothing spins") {
+    FakeLine line;
+    line.start();
+    const fe::Duration t3_5 = line.core.master().timing().t3_5();
+    line.submit(read_tx(0, 1, Priority::poll), "first");
+    line.advance(0ms);
+    CHECK(line.exact_at == t0 + t3_5);
+    line.advance(1ms);
+    CHECK(line.spins == 0);
+    CHECK(line.last_write_at == t0 + t3_5);
+}
+
+TEST_CASE("line core: precise timing spins at once when the silence is shorter than the lead (921600 bit/s)") {
+    FakeLine line(precise(921600));
+    line.start();
+    const fe::Duration t3_5 = line.core.master().timing().t3_5();  // 38 us
+    REQUIRE(t3_5 < 200us);
+    line.submit(read_tx(0, 1, Priority::poll), "first");
+    line.advance(0ms);
+    CHECK(line.spins == 1);
+    CHECK(line.exact_sets == 0);  // no timer at all
+    CHECK(line.last_write_at == t0 + t3_5);
+    CHECK(line.take_written() == read_request);
+}
+
+TEST_CASE("line core: a byte that arrives during the spin pushes the request out by a new silence") {
+    FakeLine line(precise());
+    line.start();
+    const fe::Duration t3_5 = line.core.master().timing().t3_5();
+    line.submit(read_tx(0, 1, Priority::poll), "first");
+    line.advance(0ms);
+    line.arrive_during_spin.push_back(Bytes{0x55});
+    const unsigned reads_before = line.reads;
+    line.advance_to(t0 + t3_5 - 200us);
+    // The port is read after the spin, before the write: the stray byte is seen.
+    CHECK(line.reads == reads_before + 1);
+    CHECK(line.written.empty());
+    CHECK(line.core.master().counters().garbage_bytes == 1);
+    // The silence counts again from the byte (read at the end of the spin).
+    line.advance(1ms);
+    CHECK(line.spins == 2);
+    CHECK(line.last_write_at == t0 + t3_5 + t3_5);
+    CHECK(line.take_written() == read_request);
+}
+
+TEST_CASE("line core: precise timing leaves reply timeouts to the timers") {
+    fe::LineCoreConfig config = precise();
+    FakeLine line(config);
+    line.start();
+    send_read(line, "lost", Priority::poll, false);
+    const unsigned spins = line.spins;
+    line.advance(150ms);  // the 100 ms response timeout passes with no reply
+    CHECK(line.recorder.status("lost") == OutcomeStatus::timeout);
+    CHECK(line.spins == spins);
 }
 
 }  // namespace

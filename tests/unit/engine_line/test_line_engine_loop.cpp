@@ -35,7 +35,7 @@ fe::LineTimingConfig short_timeouts() {
 /// then the timers.
 struct Simulation {
     std::mt19937 rng{20240601};
-    fe::LineCore core{config(), "/dev/ttySIM"};
+    fe::LineCore core;
     fe::LineDelivery delivery{"A", {}};
     std::multimap<TimePoint, Bytes> rx;  // bytes the bus delivers, by time
     TimePoint now = t0;
@@ -56,6 +56,7 @@ struct Simulation {
     std::uint64_t writes = 0;
     std::uint64_t blocked_writes = 0;
     std::uint64_t early_writes = 0;
+    std::uint64_t spins = 0;
     struct WaitingCommand {
         std::uint64_t number = 0;
         unsigned others_allowed = 0;  // the one in flight when it was queued, if not written yet
@@ -67,14 +68,16 @@ struct Simulation {
     std::size_t max_dead_queue = 0;
     std::map<fe::DeviceIndex, bool> poll_outstanding;
 
-    static fe::LineCoreConfig config() {
+    static fe::LineCoreConfig config(Duration spin_lead) {
         fe::LineCoreConfig config;
         config.name = "A";
         config.timing = short_timeouts();
+        config.spin_lead = spin_lead;
         return config;
     }
 
-    Simulation() {
+    /// @p spin_lead: precise silence timing (LineCoreConfig::spin_lead), zero: off.
+    explicit Simulation(Duration spin_lead) : core(config(spin_lead), "/dev/ttySIM") {
         fe::DeviceLimits limits;
         limits.read_retries = 1;
         limits.offline_after = 3;
@@ -108,6 +111,13 @@ struct Simulation {
                 case fe::LineNext::none: return;
                 case fe::LineNext::resume:
                 case fe::LineNext::tick: event = fe::line_event::Resume{}; break;
+                case fe::LineNext::spin:
+                    ++spins;
+                    REQUIRE(step.spin_until > now);
+                    REQUIRE(step.spin_until - now <= core.config().spin_lead);
+                    now = step.spin_until;  // bytes due meanwhile are in rx for the next read
+                    event = fe::line_event::Resume{};
+                    break;
                 case fe::LineNext::open: event = fe::line_event::Opened{"simulated"}; break;
                 case fe::LineNext::read: event = read(); break;
                 case fe::LineNext::write: event = write(step.write); break;
@@ -300,8 +310,7 @@ struct Simulation {
     }
 };
 
-TEST_CASE("engine loop: two virtual seconds of mixed traffic over a faulty bus") {
-    Simulation sim;
+void run_mixed_traffic(Simulation& sim) {
     sim.run(t0 + 2s, true);
     // Drain: no new traffic; everything queued is served or probed.
     sim.run(t0 + 10s, false);
@@ -351,6 +360,18 @@ TEST_CASE("engine loop: two virtual seconds of mixed traffic over a faulty bus")
     CHECK(sim.scheduler().online(0));
     CHECK(sim.scheduler().online(1));
     CHECK(sim.scheduler().online(2));
+}
+
+TEST_CASE("engine loop: two virtual seconds of mixed traffic over a faulty bus") {
+    Simulation sim(Duration::zero());
+    run_mixed_traffic(sim);
+    CHECK(sim.spins == 0);
+}
+
+TEST_CASE("engine loop: the same with precise silence timing (the silences end in spins)") {
+    Simulation sim(200us);
+    run_mixed_traffic(sim);
+    CHECK(sim.spins > 300);
 }
 
 }  // namespace
