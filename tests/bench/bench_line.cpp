@@ -1,8 +1,9 @@
 // Benchmark of the line engine (issue 3, spec section 9): the real engine::Engine,
 // built from YAML by the real loader, against `fieldbridge-sim --wire-time` on a
-// pseudo-terminal (one HIWIN XEG at 115200 bit/s, 1 ms device turnaround).
+// pseudo-terminal (one HIWIN XEG, 1 ms device turnaround, 115200 bit/s or the baud
+// given).
 //
-//   fb_bench_line [seconds=5] [writes=200]
+//   fb_bench_line [seconds=5] [writes=200] [baud=115200]
 //
 //   a. line utilisation: 16 on-demand FC04 0x0300 x2 reads kept outstanding
 //      (max_age 0), completed transactions/s against 1 / T_line;
@@ -12,12 +13,15 @@
 //      windows, the median;
 //   0. first, the floor: the same reads from a minimal master on raw system calls
 //      (raw_master.hpp) against the same simulator, for the same time: what this
-//      machine, its pseudo-terminals and the simulator allow at best.
+//      machine, its pseudo-terminals and the simulator allow at best; every line
+//      figure is printed as a ratio to the physical limit and to it. It also checks
+//      the simulator's physics from the master's side (floor_report.hpp).
 //
 // The simulator binary is named by FIELDBRIDGE_SIM (run-benchmarks sets it); it is a
 // separate process, so the CPU figure is the gateway side alone (engine, scheduler,
 // line I/O and this load generator's callbacks). Not a test: it prints figures and
-// asserts nothing.
+// asserts nothing. Lines whose figures the summary of tests/bench/run-benchmarks
+// collects start with "summary:".
 
 #include <algorithm>
 #include <asio/steady_timer.hpp>
@@ -32,7 +36,9 @@
 
 #include <fmt/format.h>
 
-#include "engine/line_timing.hpp"
+#include "floor_report.hpp"
+#include "line_limit.hpp"
+#include "load_shape.hpp"
 #include "process_cpu.hpp"
 #include "raw_master.hpp"
 #include "engine_harness.hpp"
@@ -51,11 +57,6 @@ using std::chrono::seconds;
 constexpr unsigned outstanding_reads = 16;
 constexpr std::uint16_t status_address = 0x0300;  // position + status, input registers
 constexpr std::uint16_t speed_address = 0x0631;   // "move: speed": a parameter, moves nothing alone
-// RTU frame sizes: FC04 x2 request 8, reply 3 + 4 + 2 = 9; FC16 x1 request 11, reply 8.
-constexpr std::size_t read_request_bytes = 8;
-constexpr std::size_t read_reply_bytes = 9;
-constexpr std::size_t write_request_bytes = 11;
-constexpr std::size_t write_reply_bytes = 8;
 
 double ms(Clock::duration d) { return duration<double, std::milli>(d).count(); }
 
@@ -96,7 +97,7 @@ private:
     std::uint64_t failed_ = 0;
 };
 
-std::string engine_yaml(const std::string& port) {
+std::string engine_yaml(const std::string& port, std::uint32_t baud) {
     // Polls slowed down so that (a) measures the on-demand reads alone; max_age 0: every
     // read goes to the line; a queue long enough for the readers and the writes.
     // FIELDBRIDGE_BENCH_PRECISE_TIMING=true|false sets the line's precise_timing
@@ -108,7 +109,7 @@ gateway: {{ id: bench-line }}
 lines:
   - name: line-a
     port: {}
-    baud: 115200
+    baud: {}
     turnaround: 0ms{}
     devices:
       - name: xeg
@@ -120,43 +121,30 @@ lines:
         command_ttl: 1s
         poll: {{ fast: 60min, slow: 60min, motion: 60min }}
 )",
-                       port, precise_line);
+                       port, baud, precise_line);
 }
 
-int run(double run_seconds, int write_count) {
-    const engine::LineTiming timing(engine::CharacterFormat{115200, 8, false, 1});
+int run(double run_seconds, int write_count, std::uint32_t baud) {
+    const bench::LoadShape shape(bench::LoadShape::Kind::xeg);
     const auto turnaround = milliseconds{1};
-    const double t_read = duration<double, std::milli>(
-                              timing.transaction_time(read_request_bytes, read_reply_bytes, turnaround))
-                              .count();
-    const double t_write = duration<double, std::milli>(
-                               timing.transaction_time(write_request_bytes, write_reply_bytes, turnaround))
-                               .count();
-    const double limit_tps = 1000.0 / t_read;
+    const bench::LineLimit limit = bench::line_limit(shape, baud, turnaround);
+    const double t_read = limit.t_read_ms;
+    const double t_write = limit.t_write_ms;
+    const double limit_tps = limit.limit_tps;
 
-    SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--wire-time", "--baud", "115200", "--turnaround", "1ms"});
+    SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--wire-time", "--baud", std::to_string(baud),
+                    "--turnaround", "1ms"});
 
     // ---- 0: the floor ---------------------------------------------------------------
-    const bench::RawMasterResult floor =
-        bench::run_raw_master(sim.path("line-a"), 2, status_address, duration<double>(run_seconds));
-    const double floor_tps = static_cast<double>(floor.transactions) / floor.seconds;
-    const double floor_cpu = floor.user_cpu_us + floor.sys_cpu_us;
-    std::printf("== fb_bench_line (0) floor: minimal raw-syscall master, same reads, same simulator ==\n");
-    std::printf("floor: %llu reads in %.3f s = %.1f tx/s, ratio %.3f; %llu timeouts; CPU %.1f us/transaction "
-                "(user %.1f + kernel %.1f)\n",
-                static_cast<unsigned long long>(floor.transactions), floor.seconds, floor_tps, floor_tps / limit_tps,
-                static_cast<unsigned long long>(floor.timeouts), floor_cpu, floor.user_cpu_us, floor.sys_cpu_us);
-    // The simulator's wire time as a client sees it (request, 3.5-character silence,
-    // turnaround, reply): the precise figure of tests/integration/sim/test_wire_time.py,
-    // whose sanitizer build asserts an order of magnitude only.
-    const double ideal_reply =
-        t_read - duration<double, std::milli>(timing.t3_5()).count();  // without the silence after the reply
-    std::printf("floor reply time: ideal %.3f ms; median %.3f ms (+%.0f us, target < +2000 us), "
-                "p99 %.3f ms (+%.0f us)\n",
-                ideal_reply, floor.reply_median_ms, (floor.reply_median_ms - ideal_reply) * 1e3, floor.reply_p99_ms,
-                (floor.reply_p99_ms - ideal_reply) * 1e3);
+    const bench::RawMasterResult floor = bench::run_raw_master(
+        bench::RawMasterSetup{sim.path("line-a"), shape, baud, turnaround, duration<double>(run_seconds)});
+    const double floor_tps = bench::floor_rate(floor);
+    const double floor_cpu = bench::floor_cpu_us(floor);
+    std::printf("== fb_bench_line (0) floor: minimal raw-syscall master, same reads, same simulator, %u bit/s ==\n",
+                baud);
+    bench::print_floor("fb_bench_line", floor, limit);
 
-    EngineHarness h(engine_yaml(sim.path("line-a")));
+    EngineHarness h(engine_yaml(sim.path("line-a"), baud));
     h.start();
     auto& xeg = h.device("xeg");
     if (!h.run_until([&] { return xeg.online(); }, seconds{5})) {
@@ -210,7 +198,8 @@ int run(double run_seconds, int write_count) {
     };
 
     std::printf("== fb_bench_line (a) line utilisation: 16 on-demand FC04 0x0300 x2 reads outstanding ==\n");
-    std::printf("T_line (8 + 9 bytes, 115200 8N1, 1 ms turnaround) = %.3f ms -> limit %.1f tx/s\n", t_read, limit_tps);
+    std::printf("T_line (8 + 9 bytes, %u 8N1, 1 ms turnaround) = %.3f ms -> limit %.1f tx/s\n", baud, t_read,
+                limit_tps);
     std::printf("completed %.0f reads in %.3f s = %.1f tx/s, ratio %.3f (target >= 0.95); failed %llu; "
                 "%.3f of the floor's rate; windows: %s tx/s\n",
                 transactions, elapsed, tps, tps / limit_tps, static_cast<unsigned long long>(reads.failed()),
@@ -233,6 +222,10 @@ int run(double run_seconds, int write_count) {
                 "windows: %s us; %.2fx the floor's %.1f us; user %.0f %% / kernel %.0f %% (tick-sampled split)\n",
                 windows, cpu_us, list(window_cpu, "{:.1f}").c_str(), floor_cpu > 0.0 ? cpu_us / floor_cpu : 0.0,
                 floor_cpu, 100.0 * user_total / (user_total + sys_total), 100.0 * sys_total / (user_total + sys_total));
+    std::printf("summary: engine line rate xeg at %u bit/s: %.1f tx/s = %.3f of the limit (target >= 0.95), %.3f of "
+                "the floor (floor %.3f of the limit); CPU %.1f us/transaction = %.2fx the floor's %.1f us\n",
+                baud, tps, tps / limit_tps, floor_tps > 0.0 ? tps / floor_tps : 0.0, floor_tps / limit_tps, cpu_us,
+                floor_cpu > 0.0 ? cpu_us / floor_cpu : 0.0, floor_cpu);
 
     // ---- b: command latency under saturating reads --------------------------------
     std::vector<double> latencies;
@@ -284,6 +277,9 @@ int run(double run_seconds, int write_count) {
     std::printf("ratios to the recomputed ideal: p50 %.2f (target <= 1.2), max %.2f (target <= 1.5)\n",
                 p50 / ideal_p50, max / ideal_max);
     std::printf("ratios to the spec's figures (4.67 / 6.21 ms): p50 %.2f, max %.2f\n", p50 / 4.67, max / 6.21);
+    std::printf("summary: engine write xeg at %u bit/s under 16 reads: p50 %.3f ms = %.2fx the priority ideal "
+                "(target <= 1.2), max %.3f ms = %.2fx (target <= 1.5)\n",
+                baud, p50, p50 / ideal_p50, max, max / ideal_max);
     const auto bus2 = sim.stats()["buses"]["line-a"];
     std::printf("simulator gap_violations after (b): %llu\n",
                 static_cast<unsigned long long>(counter(bus2, "gap_violations")));
@@ -299,11 +295,12 @@ int main(int argc, char** argv) {
     try {
         const double seconds_arg = argc > 1 ? std::atof(argv[1]) : 5.0;
         const int writes_arg = argc > 2 ? std::atoi(argv[2]) : 200;
-        if (seconds_arg <= 0.0 || writes_arg <= 0) {
-            std::fprintf(stderr, "usage: fb_bench_line [seconds>0] [writes>0]\n");
+        const long baud_arg = argc > 3 ? std::atol(argv[3]) : 115200;
+        if (seconds_arg <= 0.0 || writes_arg <= 0 || baud_arg <= 0) {
+            std::fprintf(stderr, "usage: fb_bench_line [seconds>0] [writes>0] [baud>0]\n");
             return 2;
         }
-        return run(seconds_arg, writes_arg);
+        return run(seconds_arg, writes_arg, static_cast<std::uint32_t>(baud_arg));
     } catch (const std::exception& e) {
         std::fprintf(stderr, "fb_bench_line: %s\n", e.what());
         return 1;

@@ -1,30 +1,40 @@
-// Benchmark of the whole gateway over Modbus TCP (issue 4, spec section 9): the real
-// `fieldbridge` daemon on a generated configuration, two lines on `fieldbridge-sim
-// --wire-time` pseudo-terminals (115200 bit/s, 1 ms device turnaround), one HIWIN XEG
-// on each, and load-generating client threads in this process.
+// Benchmark of the whole gateway over Modbus TCP (issues 4 and 14, spec section 9):
+// the real `fieldbridge` daemon on a generated configuration, its lines on
+// `fieldbridge-sim --wire-time` pseudo-terminals (1 ms device turnaround), and the
+// load-generating clients in this process.
 //
 //   FIELDBRIDGE_SIM=<fieldbridge-sim> fb_bench_tcp_daemon <fieldbridge> [seconds=5] [writes=200]
+//       [--shape=xeg|generic] [--baud=115200] [--clients=16[,8,...]]
+//       [--parts=cache,line,scrape,write] [--paced-runs=3]
 //
-//   1. cache-served reads: 32 clients (blocking sockets, one request outstanding each)
-//      read FC04 0x0300 x2 from unit 1 (line-a, max_age 10s, polled every 100 ms):
-//      reads/s, p50/p99 latency, and the serial requests the simulator saw during the
-//      load against an idle window of the same length before it (polls only);
-//   1b. the same reads offered at the target's 50,000/s by 32 paced clients: latency
-//      at the target rate rather than at saturation;
-//   2. TCP -> line throughput: 16 clients read the same registers from unit 2 (line-b,
-//      max_age 0: every read goes to the line): transactions/s against 1 / T_line;
-//   2b. the same load while /metrics is scraped every 100 ms (a Prometheus stand-in
-//      on its own thread), then (2c) once more without: the line rate with and without
-//      scraping, and the unscraped runs' spread as the noise floor;
-//   3. command latency under load (spec section 9's set-up): 16 clients saturate
-//      line-b with those reads while a 17th writes FC06 every 30-50 ms: the write's
-//      send -> answer latency against the priority ideal.
+//   0. the floor: first, for `seconds`, the minimal raw-syscall master
+//      (raw_master.hpp) reads the same shape on a line of the same simulator at the
+//      same baud: every line figure below is printed as a ratio to the physical
+//      limit and to this floor, and the simulator's physics is checked from the
+//      master's side;
+//   cache, 1. cache-served reads: 32 clients (blocking sockets, one request
+//      outstanding each) read FC04 0x0300 x2 from unit 1 (line-a, one XEG, max_age
+//      10s, polled every 100 ms) flat out: reads/s, p50/p99, and the serial requests
+//      the simulator saw during the load against an idle window before it;
+//   cache, 1b. the same reads offered at 50,000/s by one epoll thread driving 32
+//      connections (paced_reads.hpp), latency from when due; against a null server
+//      in this process first (the generator's own tail), then against the daemon;
+//      `--paced-runs` times each, alternated;
+//   line, 2. TCP -> line throughput: N clients (each of `--clients`) read the shape
+//      from line-b (max_age 0: every read goes to the line);
+//   scrape, 2b/2c. the first of those loads while /metrics is scraped every 100 ms,
+//      then once more without;
+//   write, 3. command latency under load: 16 clients saturate line-b while a 17th
+//      writes FC06 every 30-50 ms: send -> answer against the priority ideal.
+//
+// Shapes (load_shape.hpp): `xeg`, one HIWIN XEG on line-b, FC04 0x0300 x2; `generic`,
+// four generic `modbus` devices on line-b, FC03 x2 at varying addresses.
 //
 // Clients and daemon share the machine's cores: the figures include that contention.
-// The client threads run at nice 10: they stand for other machines, and at nice 0 the
-// 32 of them starve the device simulator (which stands for hardware with its own
-// CPU) until its replies come later than the 100 ms response timeout and the device
-// goes offline. The daemon and the simulator run at the default priority.
+// The blocking client threads run at nice 10: they stand for other machines, and at
+// nice 0 the 32 of them starve the device simulator. The daemon, the simulator and
+// the paced generator run at the default priority. Lines whose figures the summary of
+// tests/bench/run-benchmarks collects start with "summary:".
 // Not a test: it prints figures and asserts nothing.
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -42,34 +52,62 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <stdexcept>
+#include <optional>
 #include <random>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "daemon_process.hpp"
-#include "engine/line_timing.hpp"
+#include "floor_report.hpp"
+#include "line_limit.hpp"
+#include "load_shape.hpp"
 #include "loopback_port.hpp"
 #include "metrics_scraper.hpp"
+#include "null_modbus_server.hpp"
+#include "paced_reads.hpp"
+#include "raw_master.hpp"
 #include "sim_process.hpp"
 
 namespace {
 
 using namespace fieldbridge;
+using bench::LoadShape;
 using Clock = std::chrono::steady_clock;
 using std::chrono::duration;
 using std::chrono::milliseconds;
 
-constexpr std::uint16_t status_address = 0x0300;
+constexpr auto turnaround = milliseconds{1};  // the simulator's device turnaround
+
+struct Options {
+    std::string daemon;
+    double seconds = 5.0;
+    int writes = 200;
+    LoadShape shape{LoadShape::Kind::xeg};
+    std::uint32_t baud = 115200;
+    std::vector<unsigned> clients{16};
+    std::vector<std::string> parts{"cache", "line", "scrape", "write"};
+    int paced_runs = 3;
+
+    [[nodiscard]] bool has(std::string_view part) const {
+        return std::find(parts.begin(), parts.end(), part) != parts.end();
+    }
+};
+
+/// What a client reads: the shape's n-th read, to unit first_unit + its device.
+struct Target {
+    LoadShape shape{LoadShape::Kind::xeg};
+    std::uint8_t first_unit = 1;
+};
 
 struct ClientResult {
-    std::vector<double> latency_us;  ///< requests sent inside the window (paced: from when due)
-    std::vector<double> service_us;  ///< paced only: from when each request actually went
+    std::vector<double> latency_us;  ///< requests sent inside the window
     std::uint64_t errors = 0;        ///< exceptions, short reads, timeouts
     std::array<std::uint64_t, 256> exceptions{};  ///< exception replies by code
     std::string failure;             ///< why the client stopped early, if it did
@@ -125,20 +163,11 @@ std::size_t exchange(int fd, std::span<const std::uint8_t> request, std::array<s
     return rest;
 }
 
-/// When a client sends: back to back (interval zero), or paced: one request every
-/// @p interval from @p first on.
-struct Pacing {
-    Clock::duration interval{};
-    Clock::time_point first{};
-};
-
-/// One Modbus TCP client: FC04 @p address x2 to @p unit, one request at a time, until
-/// @p stop; latencies recorded for requests sent in [window_start, window_end). Paced,
-/// a latency counts from when the request was due, not from when it went: an answer
-/// that comes late delays the next request, and that wait is latency too (no
-/// "coordinated omission").
-void run_client(std::uint16_t port, std::uint8_t unit, const std::atomic<bool>& stop, Clock::time_point window_start,
-                Clock::time_point window_end, Pacing pacing, ClientResult& result) {
+/// One Modbus TCP client: the reads of @p target from its @p first -th on, one at a
+/// time, back to back, until @p stop; latencies recorded for requests sent in
+/// [window_start, window_end).
+void run_client(std::uint16_t port, Target target, std::uint64_t first, const std::atomic<bool>& stop,
+                Clock::time_point window_start, Clock::time_point window_end, ClientResult& result) {
     // Linux: a thread's nice value is its own (setpriority on the thread id).
     static_cast<void>(setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10));
     const int fd = connect_client(port);
@@ -148,33 +177,24 @@ void run_client(std::uint16_t port, std::uint8_t unit, const std::atomic<bool>& 
     }
     result.latency_us.reserve(400'000);
     std::uint16_t transaction = 0;
-    while (!stop.load(std::memory_order_relaxed)) {
+    for (std::uint64_t n = first; !stop.load(std::memory_order_relaxed); ++n) {
         ++transaction;
+        const bench::ShapeRead read = target.shape.read(n);
         const std::array<std::uint8_t, 12> request{
-            static_cast<std::uint8_t>(transaction >> 8), static_cast<std::uint8_t>(transaction & 0xFF), 0, 0, 0, 6, unit,
-            0x04, static_cast<std::uint8_t>(status_address >> 8), static_cast<std::uint8_t>(status_address & 0xFF), 0,
-            2};
-        Clock::time_point sent = Clock::now();
-        Clock::time_point went = sent;
-        const bool paced = pacing.interval > Clock::duration::zero();
-        if (paced) {
-            if (sent < pacing.first) {
-                std::this_thread::sleep_until(pacing.first);
-                went = Clock::now();
-            }
-            sent = pacing.first;
-            pacing.first += pacing.interval;
-        }
+            static_cast<std::uint8_t>(transaction >> 8), static_cast<std::uint8_t>(transaction & 0xFF), 0, 0, 0, 6,
+            static_cast<std::uint8_t>(target.first_unit + read.device), read.function,
+            static_cast<std::uint8_t>(read.address >> 8), static_cast<std::uint8_t>(read.address & 0xFF),
+            static_cast<std::uint8_t>(read.count >> 8), static_cast<std::uint8_t>(read.count & 0xFF)};
+        const Clock::time_point sent = Clock::now();
         std::array<std::uint8_t, 260> reply{};
         const std::size_t rest = exchange(fd, request, reply, result.failure);
         if (rest == 0) break;
         const auto answered = Clock::now();
-        const bool ok = reply[7] == 0x04 && rest == 6;
+        const bool ok = reply[7] == read.function && rest == std::size_t{2} + 2u * read.count;
         if (!ok) ++result.errors;
-        if (reply[7] == 0x84 && rest == 2) ++result.exceptions[reply[8]];
+        if (reply[7] == (read.function | 0x80) && rest == 2) ++result.exceptions[reply[8]];
         if (ok && sent >= window_start && sent < window_end) {
             result.latency_us.push_back(duration<double, std::micro>(answered - sent).count());
-            if (paced) result.service_us.push_back(duration<double, std::micro>(answered - went).count());
         }
     }
     close(fd);
@@ -225,7 +245,6 @@ struct LoadFigures {
     double p50_us = 0.0;
     double p99_us = 0.0;
     double max_us = 0.0;
-    double service_p99_us = 0.0;  ///< paced: p99 from when requests went
     std::string failures;
 };
 
@@ -253,26 +272,26 @@ double percentile(const std::vector<double>& sorted, double p) {
     return sorted[std::min(rank, sorted.size() - 1)];
 }
 
-/// Runs @p clients clients for warm-up + @p seconds; @p in_window runs on this thread
-/// at the window's start and end (simulator counters, daemon CPU). @p rate: requests
-/// per second offered by all clients together, spread evenly over them and in phase;
-/// 0: every client sends its next request as soon as it has the answer.
+double median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    return percentile(values, 0.5);
+}
+
+/// Runs @p clients back-to-back clients for warm-up + @p seconds; @p in_window runs on
+/// this thread at the window's start and end (simulator counters, daemon CPU).
 template <typename Probe>
-LoadFigures run_load(std::uint16_t port, std::uint8_t unit, unsigned clients, double seconds, Probe&& in_window,
-                     double rate = 0.0) {
+LoadFigures run_load(std::uint16_t port, Target target, unsigned clients, double seconds, Probe&& in_window) {
     std::atomic<bool> stop{false};
     const auto start = Clock::now() + milliseconds{100};  // every client connected
     const auto window_start = start + milliseconds{400};
     const auto window_end = window_start + std::chrono::duration_cast<Clock::duration>(duration<double>(seconds));
-    const auto interval = rate > 0.0 ? std::chrono::duration_cast<Clock::duration>(
-                                           duration<double>(static_cast<double>(clients) / rate))
-                                     : Clock::duration::zero();
     std::vector<ClientResult> results(clients);
     std::vector<std::thread> threads;
     for (unsigned i = 0; i < clients; ++i) {
-        const Pacing pacing{interval, start + interval * i / clients};
-        threads.emplace_back(run_client, port, unit, std::cref(stop), window_start, window_end, pacing,
-                             std::ref(results[i]));
+        // Clients start at different points of the shape's sequence (other devices,
+        // other addresses).
+        threads.emplace_back(run_client, port, target, std::uint64_t{i} * 7, std::cref(stop), window_start,
+                             window_end, std::ref(results[i]));
     }
     std::this_thread::sleep_until(window_start);
     in_window(true);
@@ -284,11 +303,9 @@ LoadFigures run_load(std::uint16_t port, std::uint8_t unit, unsigned clients, do
     LoadFigures figures;
     figures.seconds = seconds;
     std::vector<double> all;
-    std::vector<double> service;
     std::array<std::uint64_t, 256> exceptions{};
     for (const auto& result : results) {
         all.insert(all.end(), result.latency_us.begin(), result.latency_us.end());
-        service.insert(service.end(), result.service_us.begin(), result.service_us.end());
         figures.errors += result.errors;
         for (std::size_t code = 0; code < exceptions.size(); ++code) exceptions[code] += result.exceptions[code];
         if (!result.failure.empty()) figures.failures += result.failure + "; ";
@@ -303,13 +320,58 @@ LoadFigures run_load(std::uint16_t port, std::uint8_t unit, unsigned clients, do
     figures.p50_us = percentile(all, 0.50);
     figures.p99_us = percentile(all, 0.99);
     figures.max_us = all.empty() ? 0.0 : all.back();
-    std::sort(service.begin(), service.end());
-    figures.service_p99_us = percentile(service, 0.99);
     return figures;
 }
 
-std::string daemon_yaml(std::uint16_t port, std::uint16_t metrics_port, const std::string& line_a,
-                        const std::string& line_b) {
+/// line-b's devices: one XEG (unit 2) or four generic devices (units 2-5), every
+/// read to the line.
+std::string direct_devices(const LoadShape& shape) {
+    if (shape.kind() == LoadShape::Kind::xeg) {
+        return R"(      - name: xeg-direct
+        type: hiwin-xeg
+        address: 2
+        unit_id: 2
+        max_age: 0ms
+        queue_limit: 64
+        poll: { fast: 60min, slow: 60min, motion: 60min }
+)";
+    }
+    std::string devices;
+    for (std::size_t d = 0; d < shape.devices(); ++d) {
+        // One block covering every address the shape reads (0-100) and the write's
+        // register; read once at start, then only on demand.
+        devices += fmt::format(R"(      - name: generic-{0}
+        type: modbus
+        address: {0}
+        unit_id: {1}
+        max_age: 0ms
+        queue_limit: 64
+        blocks:
+          - {{ table: holding, address: 0, count: 104, period: 1h, writable: true }}
+)",
+                               shape.bus_address(d), 2 + d);
+    }
+    return devices;
+}
+
+std::string daemon_yaml(const Options& options, std::uint16_t port, std::uint16_t metrics_port,
+                        const std::string& line_a, const std::string& line_b) {
+    std::string cached_line;
+    if (options.has("cache")) {
+        cached_line = fmt::format(R"(  - name: line-a          # cache-served reads: polled, answered from the image
+    port: {}
+    baud: {}
+    turnaround: 0ms
+    devices:
+      - name: xeg-cached
+        type: hiwin-xeg
+        address: 2
+        unit_id: 1
+        max_age: 10s
+        poll: {{ fast: 100ms, slow: 1s }}
+)",
+                                  line_a, options.baud);
+    }
     return fmt::format(R"(# Generated by fb_bench_tcp_daemon.
 gateway: {{ id: bench, log_level: info }}
 modbus_tcp:
@@ -321,46 +383,23 @@ modbus_tcp:
 metrics_http:
   listen: 127.0.0.1:{}
 lines:
-  - name: line-a          # cache-served reads: polled, answered from the image
+{}  - name: line-b          # TCP -> line: every read goes to the device
     port: {}
-    baud: 115200
+    baud: {}
     turnaround: 0ms
     devices:
-      - name: xeg-cached
-        type: hiwin-xeg
-        address: 2
-        unit_id: 1
-        max_age: 10s
-        poll: {{ fast: 100ms, slow: 1s }}
-  - name: line-b          # TCP -> line: every read goes to the device
-    port: {}
-    baud: 115200
-    turnaround: 0ms
-    devices:
-      - name: xeg-direct
-        type: hiwin-xeg
-        address: 2
-        unit_id: 2
-        max_age: 0ms
-        queue_limit: 64
-        poll: {{ fast: 60min, slow: 60min, motion: 60min }}
-)",
-                       port, metrics_port, line_a, line_b);
+{})",
+                       port, metrics_port, cached_line, line_b, options.baud, direct_devices(options.shape));
 }
 
 std::uint64_t bus_counter(const integration::SimProcess& sim, const char* bus, const char* name) {
     return sim.bus_counter(bus, name);
 }
 
-int run(const std::string& daemon_binary, double seconds, int write_count) {
-    integration::SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-b:hiwin-xeg@2",
-                                 "--wire-time", "--baud", "115200", "--turnaround", "1ms"});
-    const std::uint16_t port = bench::free_loopback_port();
-    const auto config_path = sim.dir() / "bench.yaml";
-    const std::uint16_t metrics_port = bench::free_loopback_port();
-    std::ofstream(config_path) << daemon_yaml(port, metrics_port, sim.path("line-a"), sim.path("line-b"));
-    bench::DaemonProcess daemon(daemon_binary, config_path, sim.dir() / "fieldbridge.log");
-
+/// Parts 1 and 1b: cache-served reads from line-a's image.
+void run_cache(const Options& options, const integration::SimProcess& sim, const bench::DaemonProcess& daemon,
+               std::uint16_t port) {
+    const double seconds = options.seconds;
     // Let the polls fill line-a's image, then measure an idle window: the polls alone.
     std::this_thread::sleep_for(milliseconds{1500});
     const auto idle_requests0 = bus_counter(sim, "line-a", "requests");
@@ -370,28 +409,27 @@ int run(const std::string& daemon_binary, double seconds, int write_count) {
     const double idle_elapsed = duration<double>(Clock::now() - idle0).count();
     const double idle_cpu = daemon.cpu_seconds() - idle_cpu0;
     const auto idle_requests = bus_counter(sim, "line-a", "requests") - idle_requests0;
+    const double idle_rate = static_cast<double>(idle_requests) / idle_elapsed;
 
-    // ---- 1: cache-served reads ----------------------------------------------------
     std::uint64_t a_requests0 = 0;
     std::uint64_t a_requests1 = 0;
     double cached_cpu0 = 0.0;
     double cached_cpu1 = 0.0;
-    const auto cached = run_load(port, 1, 32, seconds, [&](bool start) {
+    const Target cached_target{LoadShape(LoadShape::Kind::xeg), 1};
+    const auto cached = run_load(port, cached_target, 32, seconds, [&](bool start) {
         (start ? a_requests0 : a_requests1) = bus_counter(sim, "line-a", "requests");
         (start ? cached_cpu0 : cached_cpu1) = daemon.cpu_seconds();
     });
     const double cached_rate = static_cast<double>(cached.reads) / cached.seconds;
     const auto load_requests = a_requests1 - a_requests0;
-    const double idle_rate = static_cast<double>(idle_requests) / idle_elapsed;
-
     std::printf("== fb_bench_tcp_daemon (1) cache-served reads: 32 clients, FC04 0x0300 x2, unit 1 (max_age 10s) ==\n");
     std::printf("%llu reads in %.1f s = %.0f reads/s (target >= 50000); errors %llu%s%s\n",
                 static_cast<unsigned long long>(cached.reads), cached.seconds, cached_rate,
                 static_cast<unsigned long long>(cached.errors), cached.failures.empty() ? "" : "; client failures: ",
                 cached.failures.c_str());
     if (!cached.exceptions.empty()) std::printf("exception replies: %s\n", cached.exceptions.c_str());
-    std::printf("latency p50 %.0f us, p99 %.0f us (target < 1000), max %.0f us\n", cached.p50_us, cached.p99_us,
-                cached.max_us);
+    std::printf("latency p50 %.0f us, p99 %.0f us, max %.0f us (32 always outstanding: mostly queueing)\n",
+                cached.p50_us, cached.p99_us, cached.max_us);
     std::printf("serial requests on line-a: %llu during the load (%.1f/s) vs %llu in the idle window before "
                 "(%.1f/s, polls only): %+.1f/s caused by the reads (target 0)\n",
                 static_cast<unsigned long long>(load_requests),
@@ -399,60 +437,105 @@ int run(const std::string& daemon_binary, double seconds, int write_count) {
                 idle_rate, static_cast<double>(load_requests) / cached.seconds - idle_rate);
     std::printf("daemon CPU during the load: %.2f s of %.1f s (%.0f%% of one core; the clients use the rest)\n",
                 cached_cpu1 - cached_cpu0, cached.seconds, 100.0 * (cached_cpu1 - cached_cpu0) / cached.seconds);
-    std::printf("daemon idle CPU (two lines, one polled at 100 ms / 1 s): %.2f%% of one core; RSS %ld KiB\n",
+    std::printf("daemon idle CPU (line-a polled at 100 ms / 1 s, line-b idle): %.2f%% of one core; RSS %ld KiB\n",
                 100.0 * idle_cpu / idle_elapsed, daemon.rss_kib());
+    std::printf("summary: cache reads flat out (32 clients): %.0f reads/s, p99 %.0f us; line-a %+.1f requests/s "
+                "caused by them\n",
+                cached_rate, cached.p99_us, static_cast<double>(load_requests) / cached.seconds - idle_rate);
     print_warnings(daemon.log_text(), "during (1)");
-    {
-        const auto bus = sim.stats()["buses"]["line-a"];
-        std::printf("simulator line-a: %s requests, %s replies, reply lateness %s\n",
-                    bus.value("requests", nlohmann::json(0)).dump().c_str(),
-                    bus.value("replies", nlohmann::json(0)).dump().c_str(),
-                    bus.contains("timing") ? bus["timing"].dump().c_str() : "?");
-    }
 
-    // ---- 1b: cache-served reads offered at the target rate -------------------------
-    // (1) runs the clients flat out: its latency is mostly queueing (32 requests always
-    // outstanding on two shared cores, latency ~ 32 / throughput). Here the same 32
-    // clients offer the target's 50,000 reads/s between them, evenly paced; latency
-    // from when each request was due.
+    // ---- 1b: paced at the target rate, null server and daemon alternated ------------
     constexpr double paced_rate = 50'000.0;
-    std::uint64_t paced_requests0 = 0;
-    std::uint64_t paced_requests1 = 0;
-    const auto paced = run_load(
-        port, 1, 32, seconds,
-        [&](bool start) { (start ? paced_requests0 : paced_requests1) = bus_counter(sim, "line-a", "requests"); },
-        paced_rate);
-    std::printf("== fb_bench_tcp_daemon (1b) cache-served reads offered at %.0f/s by 32 paced clients ==\n", paced_rate);
-    std::printf("%llu reads in %.1f s = %.0f reads/s (offered %.0f); errors %llu%s%s\n",
-                static_cast<unsigned long long>(paced.reads), paced.seconds,
-                static_cast<double>(paced.reads) / paced.seconds, paced_rate,
-                static_cast<unsigned long long>(paced.errors), paced.failures.empty() ? "" : "; client failures: ",
-                paced.failures.c_str());
-    std::printf("latency from when due: p50 %.0f us, p99 %.0f us (target < 1000), max %.0f us; from when sent: "
-                "p99 %.0f us; serial requests on line-a %.1f/s (polls alone: %.1f/s)\n",
-                paced.p50_us, paced.p99_us, paced.max_us, paced.service_p99_us,
-                static_cast<double>(paced_requests1 - paced_requests0) / paced.seconds, idle_rate);
+    std::printf("== fb_bench_tcp_daemon (1b) cache-served reads offered at %.0f/s: one epoll thread, 32 connections, "
+                "latency from when due; a null server in this process, then the daemon ==\n",
+                paced_rate);
+    bench::NullModbusServer null_server;
+    std::vector<double> null_p99;
+    std::vector<double> daemon_p99;
+    for (int run = 1; run <= options.paced_runs; ++run) {
+        for (const bool against_daemon : {false, true}) {
+            bench::PacedLoad load;
+            load.port = against_daemon ? port : null_server.port();
+            load.rate = paced_rate;
+            load.window = duration<double>(seconds);
+            const auto requests0 = bus_counter(sim, "line-a", "requests");
+            const double cpu0 = daemon.cpu_seconds();
+            const bench::PacedFigures paced = bench::run_paced_reads(load);
+            const double cpu = daemon.cpu_seconds() - cpu0;
+            const auto requests = bus_counter(sim, "line-a", "requests") - requests0;
+            (against_daemon ? daemon_p99 : null_p99).push_back(paced.p99_us);
+            std::printf("run %d %-11s: %llu reads in %.1f s = %.0f reads/s; from when due p50 %.0f us, p99 %.0f us, "
+                        "max %.0f us; from when sent p99 %.0f us; sent > 100 us late %llu, unanswered %llu, errors "
+                        "%llu%s%s",
+                        run, against_daemon ? "daemon" : "null server", static_cast<unsigned long long>(paced.reads),
+                        paced.seconds, static_cast<double>(paced.reads) / paced.seconds, paced.p50_us, paced.p99_us,
+                        paced.max_us, paced.service_p99_us, static_cast<unsigned long long>(paced.late_sends),
+                        static_cast<unsigned long long>(paced.unanswered),
+                        static_cast<unsigned long long>(paced.errors), paced.failure.empty() ? "" : "; failed: ",
+                        paced.failure.c_str());
+            if (against_daemon) {
+                std::printf("; daemon CPU %.0f%% of one core; line-a %.1f requests/s (polls alone %.1f/s)",
+                            100.0 * cpu / seconds, static_cast<double>(requests) / seconds, idle_rate);
+            }
+            std::printf("\n");
+        }
+    }
+    std::printf("summary: cache reads paced at 50000/s, p99 from when due (target < 1000 us), median of %d runs: "
+                "daemon %.0f us, null server %.0f us\n",
+                options.paced_runs, median(daemon_p99), median(null_p99));
+    print_warnings(daemon.log_text(), "during (1b)");
+}
 
-    // ---- 2: TCP -> line throughput ------------------------------------------------
-    const engine::LineTiming timing(engine::CharacterFormat{115200, 8, false, 1});
-    const double t_line =
-        duration<double, std::milli>(timing.transaction_time(8, 9, milliseconds{1})).count();
-    const double limit = 1000.0 / t_line;
-    // 16 clients reading unit 2 (every read goes to line-b): the figures, the line's
-    // requests in the window (the simulator's count) and the daemon's CPU per request.
-    struct LineLoad {
-        LoadFigures figures;
-        double rate = 0.0;
-        std::uint64_t requests = 0;
-        double cpu_us = 0.0;
-    };
-    const auto line_b_load = [&] {
+struct LineLoad {
+    LoadFigures figures;
+    double rate = 0.0;
+    std::uint64_t requests = 0;
+    double cpu_us = 0.0;
+};
+
+int run(const Options& options) {
+    const double seconds = options.seconds;
+    const LoadShape& shape = options.shape;
+    const bench::LineLimit limit = bench::line_limit(shape, options.baud, turnaround);
+    const std::string baud = std::to_string(options.baud);
+    integration::SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-b:" + shape.sim_devices(),
+                                 "--bus", "{dir}/line-floor:" + shape.sim_devices(), "--wire-time", "--baud", baud,
+                                 "--turnaround", "1ms"});
+    const std::string label = fmt::format("{} at {} bit/s", shape.name(), options.baud);
+    std::printf("fb_bench_tcp_daemon: shape %s (%s) at %u bit/s 8N1, 1 ms turnaround; T_line %.3f ms -> limit %.1f "
+                "tx/s; t3.5 %.1f us\n",
+                std::string(shape.name()).c_str(), std::string(shape.description()).c_str(), options.baud,
+                limit.t_read_ms, limit.limit_tps, limit.t3_5_us);
+
+    // ---- 0: the floor, before the daemon runs -------------------------------------
+    const bool line_parts = options.has("line") || options.has("scrape") || options.has("write");
+    bench::RawMasterResult floor;
+    if (line_parts) {
+        floor = bench::run_raw_master(
+            bench::RawMasterSetup{sim.path("line-floor"), shape, options.baud, turnaround, duration<double>(seconds)});
+        std::printf("== fb_bench_tcp_daemon (0) floor: minimal raw-syscall master, %s ==\n", label.c_str());
+        bench::print_floor("fb_bench_tcp_daemon", floor, limit);
+    }
+    const double floor_tps = bench::floor_rate(floor);
+    const double floor_cpu = bench::floor_cpu_us(floor);
+    const auto of_floor = [&](double tps) { return floor_tps > 0.0 ? tps / floor_tps : 0.0; };
+
+    const std::uint16_t port = bench::free_loopback_port();
+    const auto config_path = sim.dir() / "bench.yaml";
+    const std::uint16_t metrics_port = bench::free_loopback_port();
+    std::ofstream(config_path) << daemon_yaml(options, port, metrics_port, sim.path("line-a"), sim.path("line-b"));
+    bench::DaemonProcess daemon(options.daemon, config_path, sim.dir() / "fieldbridge.log");
+
+    if (options.has("cache")) run_cache(options, sim, daemon, port);
+
+    const Target direct_target{shape, 2};
+    const auto line_b_load = [&](unsigned clients) {
         std::uint64_t r0 = 0;
         std::uint64_t r1 = 0;
         double cpu0 = 0.0;
         double cpu1 = 0.0;
         LineLoad load;
-        load.figures = run_load(port, 2, 16, seconds, [&](bool start) {
+        load.figures = run_load(port, direct_target, clients, seconds, [&](bool start) {
             (start ? r0 : r1) = bus_counter(sim, "line-b", "requests");
             (start ? cpu0 : cpu1) = daemon.cpu_seconds();
         });
@@ -461,121 +544,189 @@ int run(const std::string& daemon_binary, double seconds, int write_count) {
         load.cpu_us = r1 == r0 ? 0.0 : (cpu1 - cpu0) * 1e6 / static_cast<double>(r1 - r0);
         return load;
     };
-    const LineLoad unscraped_first = line_b_load();
-    const auto& direct = unscraped_first.figures;
-    const double direct_rate = unscraped_first.rate;
-    const auto b_requests = unscraped_first.requests;
-    std::printf("== fb_bench_tcp_daemon (2) TCP -> line: 16 clients, FC04 0x0300 x2, unit 2 (max_age 0) ==\n");
-    std::printf("T_line = %.3f ms -> limit %.1f tx/s\n", t_line, limit);
-    std::printf("%llu reads answered in %.1f s = %.1f tx/s, ratio %.3f (target >= 0.95); errors %llu%s%s\n",
-                static_cast<unsigned long long>(direct.reads), direct.seconds, direct_rate, direct_rate / limit,
-                static_cast<unsigned long long>(direct.errors), direct.failures.empty() ? "" : "; client failures: ",
-                direct.failures.c_str());
-    if (!direct.exceptions.empty()) std::printf("exception replies: %s\n", direct.exceptions.c_str());
-    std::printf("simulator line-b requests in the window: %llu = %.1f/s, ratio %.3f\n",
-                static_cast<unsigned long long>(b_requests), static_cast<double>(b_requests) / direct.seconds,
-                static_cast<double>(b_requests) / direct.seconds / limit);
-    std::printf("latency p50 %.2f ms, p99 %.2f ms, max %.2f ms (16 clients queued on one line: about 16 x T_line)\n",
-                direct.p50_us / 1000.0, direct.p99_us / 1000.0, direct.max_us / 1000.0);
-    std::printf("daemon CPU per serial transaction (TCP + engine): %.1f us\n", unscraped_first.cpu_us);
+    if (line_parts) std::this_thread::sleep_for(milliseconds{500});  // the generic blocks' first reads
+
+    // ---- 2: TCP -> line throughput ------------------------------------------------
+    std::vector<LineLoad> unscraped;
+    if (options.has("line") || options.has("scrape")) {
+        for (const unsigned clients : options.clients) {
+            unscraped.push_back(line_b_load(clients));
+            const LineLoad& load = unscraped.back();
+            const auto& f = load.figures;
+            std::printf("== fb_bench_tcp_daemon (2) TCP -> line: %u clients, %s, max_age 0 ==\n", clients,
+                        label.c_str());
+            std::printf("%llu reads answered in %.1f s = %.1f tx/s; errors %llu%s%s\n",
+                        static_cast<unsigned long long>(f.reads), f.seconds, load.rate,
+                        static_cast<unsigned long long>(f.errors), f.failures.empty() ? "" : "; client failures: ",
+                        f.failures.c_str());
+            if (!f.exceptions.empty()) std::printf("exception replies: %s\n", f.exceptions.c_str());
+            std::printf("simulator line-b requests in the window: %llu = %.1f/s\n",
+                        static_cast<unsigned long long>(load.requests),
+                        static_cast<double>(load.requests) / f.seconds);
+            std::printf("latency p50 %.2f ms, p99 %.2f ms, max %.2f ms\n", f.p50_us / 1000.0, f.p99_us / 1000.0,
+                        f.max_us / 1000.0);
+            std::printf("summary: TCP->line %s, %u clients: %.1f tx/s = %.3f of the limit (target >= 0.95), %.3f of "
+                        "the floor (floor %.3f of the limit); daemon CPU %.1f us/transaction = %.2fx the floor's "
+                        "%.1f us\n",
+                        label.c_str(), clients, load.rate, load.rate / limit.limit_tps, of_floor(load.rate),
+                        floor_tps / limit.limit_tps, load.cpu_us, floor_cpu > 0.0 ? load.cpu_us / floor_cpu : 0.0,
+                        floor_cpu);
+        }
+    }
 
     // ---- 2b/2c: the same load with and without scraping /metrics ---------------------
-    bench::MetricsScraper scraper(metrics_port, milliseconds{100});
-    const LineLoad scraped_load = line_b_load();
-    const auto scrapes = scraper.stop();
-    const LineLoad again_load = line_b_load();
-    const auto& scraped = scraped_load.figures;
-    const auto& again = again_load.figures;
-    const double scraped_rate = scraped_load.rate;
-    const double again_rate = again_load.rate;
-    const double scraped_cpu = scraped_load.cpu_us;
-    const double again_cpu = again_load.cpu_us;
-    const double unscraped = (direct_rate + again_rate) / 2.0;
-    std::printf("== fb_bench_tcp_daemon (2b) TCP -> line while GET /metrics every 100 ms; (2c) again without ==\n");
-    std::printf("scraped %.1f tx/s (p99 %.2f ms, errors %llu); unscraped (2) %.1f and (2c) %.1f tx/s (p99 %.2f / %.2f ms)\n",
-                scraped_rate, scraped.p99_us / 1000.0, static_cast<unsigned long long>(scraped.errors), direct_rate,
-                again_rate, direct.p99_us / 1000.0, again.p99_us / 1000.0);
-    std::printf("scraping cost: line rate %+.2f%% against the unscraped mean; unscraped runs differ by %.2f%%\n",
-                100.0 * (scraped_rate - unscraped) / unscraped, 100.0 * std::abs(direct_rate - again_rate) / unscraped);
-    std::printf("scrapes %llu ok, %llu failed%s%s; %zu bytes each; scrape latency p50 %.2f ms, max %.2f ms\n",
-                static_cast<unsigned long long>(scrapes.ok), static_cast<unsigned long long>(scrapes.failed),
-                scrapes.failure.empty() ? "" : ": ", scrapes.failure.c_str(), scrapes.last_bytes,
-                percentile(scrapes.latency_us, 0.5) / 1000.0,
-                scrapes.latency_us.empty() ? 0.0 : scrapes.latency_us.back() / 1000.0);
-    std::printf("daemon CPU per serial transaction: %.1f us scraped, %.1f us (2c) unscraped\n", scraped_cpu, again_cpu);
+    if (options.has("scrape") && !unscraped.empty()) {
+        const unsigned clients = options.clients.front();
+        bench::MetricsScraper scraper(metrics_port, milliseconds{100});
+        const LineLoad scraped = line_b_load(clients);
+        const auto scrapes = scraper.stop();
+        const LineLoad again = line_b_load(clients);
+        const double first_rate = unscraped.front().rate;
+        const double mean = (first_rate + again.rate) / 2.0;
+        std::printf("== fb_bench_tcp_daemon (2b) TCP -> line (%u clients) while GET /metrics every 100 ms; (2c) "
+                    "again without ==\n",
+                    clients);
+        std::printf("scraped %.1f tx/s (%.3f of the limit, %.3f of the floor; p99 %.2f ms, errors %llu); unscraped "
+                    "(2) %.1f and (2c) %.1f tx/s\n",
+                    scraped.rate, scraped.rate / limit.limit_tps, of_floor(scraped.rate),
+                    scraped.figures.p99_us / 1000.0, static_cast<unsigned long long>(scraped.figures.errors),
+                    first_rate, again.rate);
+        std::printf("summary: scraping cost: line rate %+.2f%% against the unscraped mean; unscraped runs differ by "
+                    "%.2f%%\n",
+                    100.0 * (scraped.rate - mean) / mean, 100.0 * std::abs(first_rate - again.rate) / mean);
+        std::printf("scrapes %llu ok, %llu failed%s%s; %zu bytes each; scrape latency p50 %.2f ms, max %.2f ms\n",
+                    static_cast<unsigned long long>(scrapes.ok), static_cast<unsigned long long>(scrapes.failed),
+                    scrapes.failure.empty() ? "" : ": ", scrapes.failure.c_str(), scrapes.last_bytes,
+                    percentile(scrapes.latency_us, 0.5) / 1000.0,
+                    scrapes.latency_us.empty() ? 0.0 : scrapes.latency_us.back() / 1000.0);
+        std::printf("daemon CPU per serial transaction: %.1f us scraped, %.1f us (2c) unscraped; floor %.1f us\n",
+                    scraped.cpu_us, again.cpu_us, floor_cpu);
+    }
 
     // ---- 3: a write's latency while 16 clients saturate the line ------------------
-    // Spec section 9's own set-up: 16 TCP clients keep line-b busy with reads, a 17th
-    // writes FC06 0x0631 ("move: speed", a parameter that moves nothing by itself),
-    // which the XEG profile sends as FC16 of one register (11 + 8 bytes).
-    const double t_write =
-        duration<double, std::milli>(timing.transaction_time(11, 8, milliseconds{1})).count();
-    std::atomic<bool> stop_readers{false};
-    std::vector<ClientResult> readers(16);
-    std::vector<std::thread> reader_threads;
-    const auto never = Clock::time_point::max();  // the readers' latencies are not wanted here
-    for (auto& reader : readers) {
-        reader_threads.emplace_back(run_client, port, 2, std::cref(stop_readers), never, never, Pacing{},
-                                    std::ref(reader));
+    if (options.has("write")) {
+        std::atomic<bool> stop_readers{false};
+        std::vector<ClientResult> readers(16);
+        std::vector<std::thread> reader_threads;
+        const auto never = Clock::time_point::max();  // the readers' latencies are not wanted here
+        for (std::size_t i = 0; i < readers.size(); ++i) {
+            reader_threads.emplace_back(run_client, port, direct_target, std::uint64_t{i} * 7, std::cref(stop_readers),
+                                        never, never, std::ref(readers[i]));
+        }
+        std::this_thread::sleep_for(milliseconds{500});
+        const auto c_requests0 = bus_counter(sim, "line-b", "requests");
+        const auto c0 = Clock::now();
+        ClientResult writes = run_writer(port, 2, shape.write_register(), options.writes);
+        const double c_seconds = duration<double>(Clock::now() - c0).count();
+        const auto c_requests = bus_counter(sim, "line-b", "requests") - c_requests0;
+        stop_readers = true;
+        for (auto& thread : reader_threads) thread.join();
+        std::uint64_t reader_errors = 0;
+        for (const auto& reader : readers) reader_errors += reader.errors + (reader.failure.empty() ? 0 : 1);
+        std::sort(writes.latency_us.begin(), writes.latency_us.end());
+        const double w_p50 = percentile(writes.latency_us, 0.50) / 1000.0;
+        const double w_p99 = percentile(writes.latency_us, 0.99) / 1000.0;
+        const double w_max = writes.latency_us.empty() ? 0.0 : writes.latency_us.back() / 1000.0;
+        const double line_rate = static_cast<double>(c_requests) / c_seconds;
+        std::printf("== fb_bench_tcp_daemon (3) write latency: 16 clients reading, one writing FC06 every 30-50 ms, "
+                    "%s ==\n",
+                    label.c_str());
+        std::printf("T_write (%zu + %zu bytes on the line) = %.3f ms; priority ideal p50 = %.3f ms, max = %.3f ms\n",
+                    shape.write_request_bytes(), shape.write_reply_bytes(), limit.t_write_ms,
+                    limit.write_ideal_p50_ms(), limit.write_ideal_max_ms());
+        std::printf("%zu writes ok, %llu failed%s%s; line-b meanwhile %.1f requests/s (%.3f of the limit, %.3f of "
+                    "the floor); reader errors %llu\n",
+                    writes.latency_us.size(), static_cast<unsigned long long>(writes.errors),
+                    writes.failure.empty() ? "" : "; writer stopped: ", writes.failure.c_str(), line_rate,
+                    line_rate / limit.limit_tps, of_floor(line_rate), static_cast<unsigned long long>(reader_errors));
+        std::printf("write latency p50 %.3f ms, p99 %.3f ms, max %.3f ms\n", w_p50, w_p99, w_max);
+        std::printf("summary: TCP write %s under 16 readers: p50 %.3f ms = %.2fx the priority ideal (target <= 1.2), "
+                    "max %.3f ms = %.2fx (target <= 1.5)\n",
+                    label.c_str(), w_p50, w_p50 / limit.write_ideal_p50_ms(), w_max, w_max / limit.write_ideal_max_ms());
     }
-    std::this_thread::sleep_for(milliseconds{500});
-    const auto c_requests0 = bus_counter(sim, "line-b", "requests");
-    const auto c0 = Clock::now();
-    ClientResult writes = run_writer(port, 2, 0x0631, write_count);
-    const double c_seconds = duration<double>(Clock::now() - c0).count();
-    const auto c_requests = bus_counter(sim, "line-b", "requests") - c_requests0;
-    stop_readers = true;
-    for (auto& thread : reader_threads) thread.join();
-    std::uint64_t reader_errors = 0;
-    for (const auto& reader : readers) reader_errors += reader.errors + (reader.failure.empty() ? 0 : 1);
-    std::sort(writes.latency_us.begin(), writes.latency_us.end());
-    const double w_p50 = percentile(writes.latency_us, 0.50) / 1000.0;
-    const double w_p99 = percentile(writes.latency_us, 0.99) / 1000.0;
-    const double w_max = writes.latency_us.empty() ? 0.0 : writes.latency_us.back() / 1000.0;
-    const double ideal_p50 = t_write + t_line / 2.0;
-    const double ideal_max = t_write + t_line;
-    std::printf("== fb_bench_tcp_daemon (3) write latency: 16 clients reading unit 2, one writing FC06 every 30-50 ms ==\n");
-    std::printf("T_write (FC16 x1 on the line, 11 + 8 bytes) = %.3f ms; priority ideal p50 = %.3f ms, max = %.3f ms\n",
-                t_write, ideal_p50, ideal_max);
-    std::printf("%zu writes ok, %llu failed%s%s; line-b meanwhile %.1f requests/s (ratio %.3f); reader errors %llu\n",
-                writes.latency_us.size(), static_cast<unsigned long long>(writes.errors),
-                writes.failure.empty() ? "" : "; writer stopped: ", writes.failure.c_str(),
-                static_cast<double>(c_requests) / c_seconds, static_cast<double>(c_requests) / c_seconds / limit,
-                static_cast<unsigned long long>(reader_errors));
-    std::printf("write latency p50 %.3f ms, p99 %.3f ms, max %.3f ms\n", w_p50, w_p99, w_max);
-    std::printf("write ratios to the recomputed ideal: p50 %.2f (target <= 1.2), max %.2f (target <= 1.5); "
-                "to the spec's 4.67 / 6.21 ms: p50 %.2f, max %.2f\n",
-                w_p50 / ideal_p50, w_max / ideal_max, w_p50 / 4.67, w_max / 6.21);
-    std::printf("gap_violations: line-a %llu, line-b %llu (target 0)\n",
+    std::printf("gap_violations: line-a %llu, line-b %llu (target 0); shortest silence on line-b %s us\n",
                 static_cast<unsigned long long>(bus_counter(sim, "line-a", "gap_violations")),
-                static_cast<unsigned long long>(bus_counter(sim, "line-b", "gap_violations")));
-    print_warnings(daemon.log_text(), "after (3)");
+                static_cast<unsigned long long>(bus_counter(sim, "line-b", "gap_violations")),
+                sim.stats()["buses"]["line-b"].value("min_silence_us", nlohmann::json("?")).dump().c_str());
+    print_warnings(daemon.log_text(), "at the end");
 
     const int daemon_status = daemon.terminate();
-    if (daemon_status != 0) std::fprintf(stderr, "fieldbridge exit status %d; log:\n%s\n", daemon_status, daemon.log_text().c_str());
+    if (daemon_status != 0) {
+        std::fprintf(stderr, "fieldbridge exit status %d; log:\n%s\n", daemon_status, daemon.log_text().c_str());
+    }
     sim.terminate();
     return 0;
+}
+
+std::vector<std::string> split(std::string_view text) {
+    std::vector<std::string> items;
+    std::size_t from = 0;
+    while (from <= text.size()) {
+        const std::size_t comma = std::min(text.find(',', from), text.size());
+        if (comma > from) items.emplace_back(text.substr(from, comma - from));
+        from = comma + 1;
+    }
+    return items;
+}
+
+Options parse(int argc, char** argv) {
+    Options options;
+    std::vector<std::string> positional;
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg = argv[i];
+        const auto value = [&](std::string_view key) -> std::optional<std::string_view> {
+            if (arg.substr(0, key.size()) != key) return std::nullopt;
+            return arg.substr(key.size());
+        };
+        if (const auto shape = value("--shape=")) {
+            options.shape = LoadShape::parse(*shape);
+        } else if (const auto baud = value("--baud=")) {
+            options.baud = static_cast<std::uint32_t>(std::stoul(std::string(*baud)));
+        } else if (const auto clients = value("--clients=")) {
+            options.clients.clear();
+            for (const auto& item : split(*clients)) options.clients.push_back(static_cast<unsigned>(std::stoul(item)));
+        } else if (const auto parts = value("--parts=")) {
+            options.parts = split(*parts);
+        } else if (const auto runs = value("--paced-runs=")) {
+            options.paced_runs = std::stoi(std::string(*runs));
+        } else if (arg.substr(0, 2) == "--") {
+            throw std::invalid_argument("unknown option " + std::string(arg));
+        } else {
+            positional.emplace_back(arg);
+        }
+    }
+    if (positional.empty()) throw std::invalid_argument("the fieldbridge binary is missing");
+    options.daemon = positional[0];
+    if (positional.size() > 1) options.seconds = std::stod(positional[1]);
+    if (positional.size() > 2) options.writes = std::stoi(positional[2]);
+    for (const auto& part : options.parts) {
+        if (part != "cache" && part != "line" && part != "scrape" && part != "write") {
+            throw std::invalid_argument("unknown part " + part + "; use cache, line, scrape, write");
+        }
+    }
+    if (options.seconds <= 0.0 || options.writes <= 0 || options.baud == 0 || options.clients.empty() ||
+        options.paced_runs <= 0) {
+        throw std::invalid_argument("seconds, writes, baud, clients and paced runs must be positive");
+    }
+    return options;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+    Options options;
     try {
-        if (argc < 2) {
-            std::fprintf(stderr, "usage: fb_bench_tcp_daemon FIELDBRIDGE [seconds=5] [writes=200]  (FIELDBRIDGE_SIM names the simulator)\n");
-            return 2;
-        }
-        const double seconds = argc > 2 ? std::atof(argv[2]) : 5.0;
-        if (seconds <= 0.0) {
-            std::fprintf(stderr, "fb_bench_tcp_daemon: seconds must be positive\n");
-            return 2;
-        }
-        const int write_count = argc > 3 ? std::atoi(argv[3]) : 200;
-        if (write_count <= 0) {
-            std::fprintf(stderr, "fb_bench_tcp_daemon: writes must be positive\n");
-            return 2;
-        }
-        return run(argv[1], seconds, write_count);
+        options = parse(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr,
+                     "fb_bench_tcp_daemon: %s\nusage: fb_bench_tcp_daemon FIELDBRIDGE [seconds=5] [writes=200] "
+                     "[--shape=xeg|generic] [--baud=115200] [--clients=16,...] [--parts=cache,line,scrape,write] "
+                     "[--paced-runs=3]  (FIELDBRIDGE_SIM names the simulator)\n",
+                     e.what());
+        return 2;
+    }
+    try {
+        return run(options);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "fb_bench_tcp_daemon: %s\n", e.what());
         return 1;

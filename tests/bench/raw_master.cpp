@@ -50,54 +50,78 @@ void sleep_until(Clock::time_point until) {
     }
 }
 
+double sorted_at(const std::vector<double>& sorted, double p) {
+    return sorted[std::min(sorted.size() - 1, static_cast<std::size_t>(static_cast<double>(sorted.size()) * p))];
+}
+
 }  // namespace
 
-RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, std::uint16_t reg,
-                               std::chrono::duration<double> duration) {
+RawMasterResult run_raw_master(const RawMasterSetup& setup) {
     // The same timer slack the line worker sets (engine/line_worker.cpp).
     ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-    const engine::LineTiming timing(engine::CharacterFormat{115200, 8, false, 1});
-    const std::array<std::uint8_t, 5> pdu{0x04, static_cast<std::uint8_t>(reg >> 8),
-                                          static_cast<std::uint8_t>(reg & 0xFF), 0x00, 0x02};
-    const protocol::Bytes request = protocol::encode_rtu(address, pdu);
-    constexpr std::size_t reply_size = 9;  // address, 04, count, 2 x 2 bytes, CRC
+    const engine::LineTiming timing(engine::CharacterFormat{setup.baud, 8, false, 1});
+    constexpr std::size_t reply_size = LoadShape::read_reply_bytes();
+    const auto bound = timing.wire_time(LoadShape::read_request_bytes()) + setup.turnaround +
+                       timing.wire_time(reply_size);
 
-    RawPort port(path);
+    RawPort port(setup.path);
     RawMasterResult result;
+    result.reply_bound_ms = std::chrono::duration<double, std::milli>(bound).count();
     const CpuTimes cpu0 = process_cpu();
     const auto start = Clock::now();
-    const auto end = start + std::chrono::duration_cast<Clock::duration>(duration);
+    const auto end = start + std::chrono::duration_cast<Clock::duration>(setup.duration);
     std::array<std::uint8_t, 256> buffer{};
     std::vector<double> reply_ms;
+    std::vector<double> silence_us;
+    std::uint64_t n = 0;
+    Clock::time_point last_reply{};
     while (Clock::now() < end) {
+        const ShapeRead read = setup.shape.read(n++);
+        const std::array<std::uint8_t, 5> pdu{read.function, static_cast<std::uint8_t>(read.address >> 8),
+                                              static_cast<std::uint8_t>(read.address & 0xFF),
+                                              static_cast<std::uint8_t>(read.count >> 8),
+                                              static_cast<std::uint8_t>(read.count & 0xFF)};
+        const protocol::Bytes request = protocol::encode_rtu(setup.shape.bus_address(read.device), pdu);
         const auto sent = Clock::now();
+        if (last_reply != Clock::time_point{}) {
+            silence_us.push_back(std::chrono::duration<double, std::micro>(sent - last_reply).count());
+        }
         if (::write(port.fd(), request.data(), request.size()) != static_cast<ssize_t>(request.size())) {
-            throw std::runtime_error("raw master: write to " + path + " failed: " + std::strerror(errno));
+            throw std::runtime_error("raw master: write to " + setup.path + " failed: " + std::strerror(errno));
         }
         std::size_t got = 0;
         while (got < reply_size) {
             pollfd readable{port.fd(), POLLIN, 0};
             if (::poll(&readable, 1, 100) <= 0) break;
-            const ssize_t n = ::read(port.fd(), buffer.data() + got, buffer.size() - got);
-            if (n > 0) got += static_cast<std::size_t>(n);
+            const ssize_t count = ::read(port.fd(), buffer.data() + got, buffer.size() - got);
+            if (count > 0) got += static_cast<std::size_t>(count);
         }
+        last_reply = Clock::now();
         if (got == reply_size) {
             ++result.transactions;
-            reply_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - sent).count());
+            if (last_reply - sent < bound) ++result.early_replies;
+            reply_ms.push_back(std::chrono::duration<double, std::milli>(last_reply - sent).count());
         } else {
             ++result.timeouts;
         }
-        sleep_until(Clock::now() + timing.t3_5());
+        sleep_until(last_reply + timing.t3_5());
     }
     const CpuTimes cpu1 = process_cpu();
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (result.transactions > 0) {
-        const auto n = static_cast<double>(result.transactions);
-        result.user_cpu_us = (cpu1.user - cpu0.user) * 1e6 / n;
-        result.sys_cpu_us = (cpu1.sys - cpu0.sys) * 1e6 / n;
+        const auto count = static_cast<double>(result.transactions);
+        result.user_cpu_us = (cpu1.user - cpu0.user) * 1e6 / count;
+        result.sys_cpu_us = (cpu1.sys - cpu0.sys) * 1e6 / count;
         std::sort(reply_ms.begin(), reply_ms.end());
-        result.reply_median_ms = reply_ms[reply_ms.size() / 2];
-        result.reply_p99_ms = reply_ms[std::min(reply_ms.size() - 1, reply_ms.size() * 99 / 100)];
+        result.reply_min_ms = reply_ms.front();
+        result.reply_median_ms = sorted_at(reply_ms, 0.5);
+        result.reply_p99_ms = sorted_at(reply_ms, 0.99);
+    }
+    if (!silence_us.empty()) {
+        std::sort(silence_us.begin(), silence_us.end());
+        result.silence_min_us = silence_us.front();
+        result.silence_median_us = sorted_at(silence_us, 0.5);
+        result.silence_p99_us = sorted_at(silence_us, 0.99);
     }
     return result;
 }

@@ -1,18 +1,34 @@
 #pragma once
 /// @file raw_master.hpp
-/// The floor of the line benchmark: the smallest possible Modbus-RTU master, written
+/// The floor of the line benchmarks: the smallest possible Modbus-RTU master, written
 /// straight on the system calls (write the request, poll() for the reply, read it,
 /// clock_nanosleep() the 3.5-character silence from the moment it was read, again).
 /// It has no event loop, scheduler, register image or error handling worth the name;
 /// what it costs per transaction on this machine is what the kernel, the
 /// pseudo-terminal and the simulator process cost, and what it achieves is what the
-/// simulator and the machine's wake-up latency allow. fb_bench_line reports the
-/// engine's figures next to it (docs/performance.md).
+/// simulator and the machine's wake-up latency allow. fb_bench_line and
+/// fb_bench_tcp_daemon report the gateway's figures next to it
+/// (docs/performance.md).
+///
+/// It also checks the simulator's physics from the master's side of the pty, with
+/// the master's own clock: no reply may be readable earlier than its request's wire
+/// time + the device turnaround + the reply's wire time after the request's first
+/// byte was written, and the silence the master keeps after each reply is measured.
 #include <chrono>
 #include <cstdint>
 #include <string>
 
+#include "load_shape.hpp"
+
 namespace fieldbridge::bench {
+
+struct RawMasterSetup {
+    std::string path;  ///< the pty
+    LoadShape shape{LoadShape::Kind::xeg};
+    std::uint32_t baud = 115200;  ///< 8N1
+    std::chrono::nanoseconds turnaround = std::chrono::milliseconds{1};  ///< the simulator's
+    std::chrono::duration<double> duration{5.0};
+};
 
 struct RawMasterResult {
     std::uint64_t transactions = 0;  ///< replies of the expected length
@@ -22,13 +38,22 @@ struct RawMasterResult {
     double sys_cpu_us = 0.0;   ///< per transaction
     /// From before the request's write to the reply's last byte read, over the
     /// transactions answered: what a client sees of the simulator's wire time.
+    double reply_min_ms = 0.0;
     double reply_median_ms = 0.0;
     double reply_p99_ms = 0.0;
+    /// The physical bound of a reply: request on the wire + turnaround + reply on the
+    /// wire (no silence); replies read earlier than that after the write began.
+    double reply_bound_ms = 0.0;
+    std::uint64_t early_replies = 0;
+    /// From the reply's last byte read to the next request's write: the silence the
+    /// master kept (it sleeps t3.5; the rest is its wake-up latency).
+    double silence_min_us = 0.0;
+    double silence_median_us = 0.0;
+    double silence_p99_us = 0.0;
 };
 
-/// Runs FC04 @p reg x2 to @p address on the pty @p path for @p duration at 115200 8N1.
-/// Throws std::runtime_error when the port cannot be opened or written.
-[[nodiscard]] RawMasterResult run_raw_master(const std::string& path, std::uint8_t address, std::uint16_t reg,
-                                             std::chrono::duration<double> duration);
+/// Runs the reads of @p setup.shape on @p setup.path until @p setup.duration has
+/// passed. Throws std::runtime_error when the port cannot be opened or written.
+[[nodiscard]] RawMasterResult run_raw_master(const RawMasterSetup& setup);
 
 }  // namespace fieldbridge::bench

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "models/excd_model.hpp"
+#include "models/generic_modbus_model.hpp"
 #include "models/wtec_ascii_model.hpp"
 #include "models/wtec_rtu_model.hpp"
 #include "models/xeg_model.hpp"
@@ -15,6 +16,7 @@ constexpr std::string_view type_xeg = "hiwin-xeg";
 constexpr std::string_view type_excd = "excd203mb";
 constexpr std::string_view type_wtec_rtu = "wtec-rtu";
 constexpr std::string_view type_wtec_ascii = "wtec-ascii";
+constexpr std::string_view type_generic = "modbus";
 
 bool excd_high_word_first(const std::string& word_order) {
     if (word_order == "high_first") return true;
@@ -26,7 +28,7 @@ bool excd_high_word_first(const std::string& word_order) {
 }  // namespace
 
 std::vector<std::string_view> device_types() {
-    return {type_xeg, type_excd, type_wtec_rtu, type_wtec_ascii};
+    return {type_xeg, type_excd, type_wtec_rtu, type_wtec_ascii, type_generic};
 }
 
 std::unique_ptr<BusDevice> make_device(std::string_view type, std::uint8_t address,
@@ -37,8 +39,9 @@ std::unique_ptr<BusDevice> make_device(std::string_view type, std::uint8_t addre
     }
     if (type == type_wtec_rtu) return make_wtec_rtu(address, options.wtec_stroke);
     if (type == type_wtec_ascii) return make_wtec_ascii(address, options.wtec_stroke);
+    if (type == type_generic) return make_generic_modbus(address);
     throw std::invalid_argument("unknown simulated device type \"" + std::string(type) +
-                                "\"; use hiwin-xeg, excd203mb, wtec-rtu or wtec-ascii");
+                                "\"; use hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii or modbus");
 }
 
 }  // namespace fieldbridge::sim

@@ -1,7 +1,7 @@
 #pragma once
 /// @file device_factory.hpp
 /// Builds a simulated bus device from its type name, as used by the simulator
-/// configuration and command line ("hiwin-xeg", "excd203mb", "wtec-rtu", "wtec-ascii").
+/// configuration and command line ("hiwin-xeg", "excd203mb", "wtec-rtu", "wtec-ascii", "modbus").
 
 #include <cstdint>
 #include <memory>

@@ -19,7 +19,7 @@ TEST_CASE("factory: every type name builds its device") {
         CHECK(device->protocol() == (type == "wtec-ascii" ? sim::BusProtocol::wtec_ascii
                                                           : sim::BusProtocol::modbus_rtu));
     }
-    CHECK(sim::device_types().size() == 4);
+    CHECK(sim::device_types().size() == 5);
 }
 
 TEST_CASE("factory: options reach the models") {
