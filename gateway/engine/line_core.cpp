@@ -125,6 +125,17 @@ void LineCore::on(TimePoint now, line_event::Submit& event, LineStep& step) {
         scheduler_.refuse(std::move(event.transaction), OutcomeStatus::cancelled, now);
         return;
     }
+    if (port_ == PortState::up && asked_ == LineNext::none && !drive_posted_ && inbox_.empty() &&
+        (master_.busy() || pick_wait_)) {
+        // The drive loop is waiting for the transaction in flight (its reply, its
+        // silence, the driver) or for the silence before the next pick, on a wake-up
+        // that is already set: nothing the submission brings can change that wait. It
+        // joins the queue now and competes at the next pick, which that wake-up makes;
+        // a drive now would only cost a pass through the reactor and a read. A
+        // refusal completes in this step (the shell delivers it from its loop).
+        scheduler_.submit(std::move(event.transaction), now);
+        return;
+    }
     // Into the inbox, handed to the scheduler by the drive loop: a submission from a
     // completion is taken before the next transaction is picked.
     inbox_.push_back(std::move(event.transaction));
@@ -341,6 +352,7 @@ void LineCore::take_inbox(TimePoint now) {
 /// delivery. @p now is fixed for the pass: every path that needs a newer one asks
 /// (read, write, tick) and goes on with the answer's.
 void LineCore::drive(TimePoint now, LineStep& step) {
+    pick_wait_ = false;
     while (true) {
         take_inbox(now);
         if (has_deliveries()) {
@@ -353,7 +365,23 @@ void LineCore::drive(TimePoint now, LineStep& step) {
         }
         if (port_ != PortState::up) return;
         if (!master_.busy()) {
-            polled_ = false;  // next() may complete expired transactions
+            // The next transaction is picked when the silence before it ends (with a
+            // spin lead: when the spin begins), not when the line becomes free: what
+            // is submitted during the silence competes for it.
+            const TimePoint pick_at = master_.earliest_send() - std::max(config_.spin_lead, Duration::zero());
+            if (now < pick_at) {
+                // What can no longer start completes now, as a pick now would do it.
+                scheduler_.expire(now);
+                if (has_deliveries()) continue;
+                const std::optional<TimePoint> wake = scheduler_.next_wakeup(now);
+                if (!wake) return;  // a submission wakes us
+                arm_wake(std::max(*wake, pick_at), now, step);
+                // Woken at the pick: a submission meanwhile needs no drive of its own.
+                pick_wait_ = *wake <= pick_at;
+                return;
+            }
+            // A pick with nothing to deliver ran no handler: a readiness report or a
+            // timer that began this pass still stands for the port (polled_).
             if (std::optional<Transaction> next = scheduler_.next(now)) master_.start(std::move(*next), now);
             if (has_deliveries()) continue;
         }
@@ -409,11 +437,10 @@ void LineCore::drive(TimePoint now, LineStep& step) {
     }
 }
 
-/// Precise silence timing (config_.spin_lead > 0): a request waiting for its silence
-/// is already picked and encoded (the master started it when the line became free, so
-/// the scheduling rules are those of the instant it was picked, as without the
-/// spin). The exact timer wakes the drive spin_lead before the instant, which covers
-/// the timer's own lateness; from there the shell spins to the instant, and the drive
+/// Precise silence timing (config_.spin_lead > 0): the drive picks the next request
+/// spin_lead before the silence ends (drive(): the exact timer, set that early, covers
+/// the timer's own lateness; a silence shorter than the lead is picked at once) and
+/// the master encodes it; from there the shell spins to the instant, and the drive
 /// reads the port and writes. Every other wait (replies, polls, broadcasts settling)
 /// is left to the timers.
 void LineCore::wait_for(TimePoint until, TimePoint now, LineStep& step) {

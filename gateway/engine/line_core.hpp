@@ -23,15 +23,23 @@
 ///                 `now` at or after it) -> Resume
 ///
 /// The drive loop (what the old LineWorker::drive() did): take the inbox into the
-/// scheduler; pick the next transaction when the master is free; read the port before
-/// a write or a timeout decision unless the reactor just looked at it (`polled`);
-/// hand out the master's write; wait for its deadline (short waits on the exact
-/// timer, long ones on a lazy timer that may wake early: arm_wake; with a spin lead,
-/// the silence before a request ends in a spin: the request, already picked and
-/// encoded, is written within microseconds of the instant); and when nothing
-/// is eligible, wait for the scheduler's next wake-up or a submission. Completions
-/// are delivered before the next transaction is picked, so a handler's submission
-/// competes for it, as before.
+/// scheduler; when the master is free, wait for the silence before the next request
+/// to end (with a spin lead: for the spin to begin), then pick the next transaction;
+/// read the port before a write or a timeout decision unless the reactor just looked
+/// at it (`polled`); hand out the master's write; wait for its deadline (short waits
+/// on the exact timer, long ones on a lazy timer that may wake early: arm_wake; with
+/// a spin lead, the silence before a request ends in a spin: the request, picked and
+/// encoded at the spin's start, is written within microseconds of the instant); and
+/// when nothing is eligible, wait for the scheduler's next wake-up or a submission.
+/// Completions are delivered before the next transaction is picked, so a handler's
+/// submission competes for it, as before; so does one made during the silence.
+///
+/// A submission posts a Drive only when the loop is not already waiting on a wake-up
+/// that ends in a pass of the drive: while a transaction is in flight (its silence,
+/// its reply, a blocked write) or the silence before the next pick runs on a timer,
+/// it goes straight to the scheduler and is considered at the next pick; a refusal
+/// (queue full, device offline...) is then among the Submit step's deliveries, which
+/// the shell hands out from its loop, never inside its own submit(), as after Stop.
 ///
 /// Every submitted transaction completes exactly once: through the scheduler (its
 /// outcome), `cancelled` by Stop, `line_down` while the port is down.
@@ -77,7 +85,9 @@ namespace line_event {
 struct Start {};
 /// Complete everything `cancelled`, close the port, cancel the timers. Idempotent.
 struct Stop {};
-/// A transaction for the line (its completion is delivered, never called here).
+/// A transaction for the line (its completion is delivered, never called here). The
+/// step may carry deliveries: the refusal of a submission after Stop, or while the
+/// line waits (see the file comment).
 struct Submit {
     Transaction transaction;
 };
@@ -240,6 +250,9 @@ private:
 
     // The drive loop.
     bool drive_posted_ = false;
+    /// At rest, master idle, a wake timer set for the silence's end: the pick then
+    /// takes what was submitted meanwhile (on(Submit) posts no drive).
+    bool pick_wait_ = false;
     bool polled_ = false;        ///< the reactor just looked at the port (drive())
     bool fresh_read_ = false;    ///< the port was read for this decision: go on to it
     bool read_for_readiness_ = false;  ///< the read answers Readable, not a decision

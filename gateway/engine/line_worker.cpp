@@ -66,8 +66,9 @@ public:
     void submit(Transaction transaction) {
         const LineStep step = core_.handle(seams_.now(), line_event::Submit{std::move(transaction)});
         apply(step);
-        // Only after stop() does a submission complete at once: on the loop, never
-        // inside submit(), and self-contained because the worker may be gone by then.
+        // A submission after stop(), or one the scheduler refused while the line
+        // waits (line_core.hpp), completes at once: on the loop, never inside
+        // submit(), and self-contained because the worker may be gone by then.
         if (core_.has_deliveries()) {
             std::vector<LineCompletion> cancelled;
             core_.scheduler().take_completions(cancelled);

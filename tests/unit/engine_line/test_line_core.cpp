@@ -301,7 +301,8 @@ TEST_CASE("line core: stop completes everything cancelled exactly once; later su
     send_read(line, "in-flight", Priority::poll, false);
     line.submit(read_tx(1, 2, Priority::poll), "queued");
     line.advance(0ms);
-    line.submit(write_tx(1, 2, 0x0601, 1), "inbox");  // not taken by a drive yet
+    // Waiting for the reply: taken by the scheduler at once, no drive.
+    line.submit(write_tx(1, 2, 0x0601, 1), "queued-write");
 
     line.feed(ev::Stop{});
     CHECK(line.core.stopped());
@@ -310,7 +311,7 @@ TEST_CASE("line core: stop completes everything cancelled exactly once; later su
     CHECK_FALSE(line.lazy_at);
     CHECK(line.recorder.status("in-flight") == OutcomeStatus::timeout);  // it went out
     CHECK(line.recorder.status("queued") == OutcomeStatus::cancelled);
-    CHECK(line.recorder.status("inbox") == OutcomeStatus::cancelled);
+    CHECK(line.recorder.status("queued-write") == OutcomeStatus::cancelled);
     CHECK(line.states == std::vector<bool>{true, false});
     CHECK(line.logged(fe::LogLevel::info, "line L: stopped, port /dev/ttyFAKE closed"));
 
@@ -353,13 +354,18 @@ TEST_CASE("line core: a completion may stop the line") {
     line.start();
     line.submit(read_tx(1, 2, Priority::poll), "second");
     Transaction first = read_tx(0, 1, Priority::command);
-    first.on_done = [&](const fe::Outcome&) { line.feed(ev::Stop{}); };
+    first.on_done = [&](const fe::Outcome&) {
+        // Submitted during the deliveries: still in the inbox when the line stops.
+        line.feed(ev::Submit{tagged(read_tx(0, 1, Priority::poll), line.recorder, "inbox")});
+        line.feed(ev::Stop{});
+    };
     line.feed(ev::Submit{std::move(first)});
     line.advance(1ms);
     line.take_written();
     line.arrive(reply_1());
     CHECK(line.core.stopped());
     CHECK(line.recorder.status("second") == OutcomeStatus::cancelled);
+    CHECK(line.recorder.status("inbox") == OutcomeStatus::cancelled);
     line.advance(1s);
     CHECK(line.written.empty());
 }
@@ -404,18 +410,87 @@ TEST_CASE("line core: a request the driver takes in pieces resumes on writabilit
 }
 
 TEST_CASE("line core: a reply already in the driver's buffer is read before the timeout is judged") {
-    // A drive posted by a submission can run after the reply deadline, before the
-    // port's readiness handler (a loop held up): it must read first.
+    // The reply timer can run after the reply deadline, before the port's readiness
+    // handler (a loop held up): it must read first.
     FakeLine line;
     line.start();
     send_read(line, "poll", Priority::poll, false);
     line.now += 1s;  // the loop was held up: no timer ran
     line.input.push_back(reply_1());
-    line.submit(read_tx(1, 2, Priority::poll), "other");
+    REQUIRE(line.lazy_at);
     const unsigned reads_before = line.reads;
-    line.advance(0ms);  // the posted drive
+    line.lazy_at.reset();
+    line.feed(ev::TimerFired{fe::WakeTimer::lazy});
     CHECK(line.reads > reads_before);
     CHECK(line.recorder.status("poll") == OutcomeStatus::ok);
+}
+
+TEST_CASE("line core: a submission while the line waits asks no drive and no read; one while idle goes at once") {
+    FakeLine line;
+    line.start();
+    send_read(line, "first");
+    unsigned reads = line.reads;
+
+    // Waiting for the reply: the submission joins the queue, nothing else happens.
+    line.submit(read_tx(1, 2, Priority::poll), "during-reply");
+    CHECK_FALSE(line.drive_posted);
+    CHECK(line.core.scheduler().queued() == 1);
+    line.advance(1ms);
+    CHECK(line.reads == reads);
+    CHECK(line.written.empty());
+
+    // The silence after the reply, on its timer: the same.
+    line.arrive(reply_1());
+    CHECK(line.reads == reads + 1);
+    REQUIRE(line.exact_at);
+    const TimePoint silence_end = *line.exact_at;
+    line.submit(read_tx(0, 1, Priority::poll), "during-silence");
+    CHECK_FALSE(line.drive_posted);
+    line.advance_to(silence_end);
+    CHECK(line.reads == reads + 1);  // the timer's pass writes without a read
+    CHECK(line.last_write_at == silence_end);
+    CHECK(line.take_written().front() == 2);  // the older of the two
+    line.advance(1ms);
+    line.arrive(read_reply(2, {7, 8}));
+    REQUIRE(line.exact_at);
+    line.advance_to(*line.exact_at);
+    CHECK(line.take_written() == read_request);
+    line.advance(1ms);
+    line.arrive(reply_1());
+    CHECK(line.recorder.status("during-reply") == OutcomeStatus::ok);
+    CHECK(line.recorder.status("during-silence") == OutcomeStatus::ok);
+
+    // Idle, nothing queued: a command needs the drive, and goes at once.
+    line.advance(50ms);
+    line.submit(write_tx(0, 1, 0x0601, 1), "idle-command");
+    CHECK(line.drive_posted);
+    const TimePoint submitted_at = line.now;
+    line.advance(0ms);
+    const Bytes written = line.take_written();
+    REQUIRE(written.size() > 2);
+    CHECK(written[1] == fp::fc::write_single_register);
+    CHECK(line.last_write_at == submitted_at);
+}
+
+TEST_CASE("line core: a command submitted in the silence after a reply goes before the read already queued") {
+    FakeLine line;
+    line.start();
+    send_read(line, "first");
+    line.submit(read_tx(1, 2, Priority::poll), "queued-read");
+    line.advance(1ms);
+    line.arrive(reply_1());
+    REQUIRE(line.recorder.status("first") == OutcomeStatus::ok);
+    REQUIRE(line.exact_at);
+    // Nothing is picked while the silence runs.
+    CHECK_FALSE(line.core.master().busy());
+    line.now += 100us;  // within the 304 us silence
+    line.submit(write_tx(0, 1, 0x0601, 1), "command");
+    line.advance(1ms);
+    const Bytes next = line.take_written();
+    REQUIRE(next.size() > 2);
+    CHECK(next[0] == 1);
+    CHECK(next[1] == fp::fc::write_single_register);
+    CHECK(line.recorder.calls("queued-read") == 0);
 }
 
 TEST_CASE("line core: after a readiness report or a timer the write needs no read; a posted drive reads first") {
@@ -504,9 +579,9 @@ TEST_CASE("line core: precise timing wakes the spin lead before the silence ends
     REQUIRE(t3_5 > 200us);
     line.submit(read_tx(0, 1, Priority::poll), "first");
     line.advance(0ms);
-    // Picked and encoded when the line became free; the timer is set the lead early.
+    // The timer is set the lead early; the request is picked and encoded then.
     REQUIRE(line.exact_at == t0 + t3_5 - 200us);
-    CHECK(line.core.master().state() == fe::MasterState::waiting_silence);
+    CHECK_FALSE(line.core.master().busy());
     CHECK(line.spins == 0);
     line.advance_to(t0 + t3_5 - 200us);
     CHECK(line.spins == 1);
@@ -524,6 +599,26 @@ TEST_CASE("line core: precise timing wakes the spin lead before the silence ends
     CHECK(line.spins == 2);
     CHECK(line.last_write_at == reply_at + t3_5);
     CHECK_FALSE(line.take_written().empty());
+}
+
+TEST_CASE("line core: precise timing picks at the early wake: a command submitted before it goes first") {
+    FakeLine line(precise());
+    line.start();
+    const fe::Duration t3_5 = line.core.master().timing().t3_5();
+    send_read(line, "first");
+    line.submit(read_tx(1, 2, Priority::poll), "queued-read");
+    line.advance(1ms);
+    const TimePoint reply_at = line.now;
+    line.arrive(reply_1());
+    REQUIRE(line.exact_at == reply_at + t3_5 - 200us);
+    line.now += 50us;  // before the early wake
+    line.submit(write_tx(0, 1, 0x0601, 1), "command");
+    CHECK_FALSE(line.drive_posted);
+    line.advance_to(reply_at + t3_5);
+    CHECK(line.last_write_at == reply_at + t3_5);  // the spin's end, as before
+    const Bytes next = line.take_written();
+    REQUIRE(next.size() > 2);
+    CHECK(next[1] == fp::fc::write_single_register);
 }
 
 TEST_CASE("line core: without precise timing the exact timer is set to the instant and nothing spins") {
