@@ -72,6 +72,7 @@
 #include "metrics_scraper.hpp"
 #include "null_modbus_server.hpp"
 #include "paced_reads.hpp"
+#include "percentile.hpp"
 #include "raw_master.hpp"
 #include "sim_process.hpp"
 
@@ -266,15 +267,9 @@ void print_warnings(const std::string& log, const char* when) {
     if (total > shown) std::printf("daemon log %s: ... %d warnings/errors in all\n", when, total);
 }
 
-double percentile(const std::vector<double>& sorted, double p) {
-    if (sorted.empty()) return 0.0;
-    const auto rank = static_cast<std::size_t>(p * static_cast<double>(sorted.size() - 1) + 0.5);
-    return sorted[std::min(rank, sorted.size() - 1)];
-}
-
 double median(std::vector<double> values) {
     std::sort(values.begin(), values.end());
-    return percentile(values, 0.5);
+    return bench::percentile_of_sorted(values, 0.5);
 }
 
 /// Runs @p clients back-to-back clients for warm-up + @p seconds; @p in_window runs on
@@ -317,8 +312,8 @@ LoadFigures run_load(std::uint16_t port, Target target, unsigned clients, double
     }
     std::sort(all.begin(), all.end());
     figures.reads = all.size();
-    figures.p50_us = percentile(all, 0.50);
-    figures.p99_us = percentile(all, 0.99);
+    figures.p50_us = bench::percentile_of_sorted(all, 0.50);
+    figures.p99_us = bench::percentile_of_sorted(all, 0.99);
     figures.max_us = all.empty() ? 0.0 : all.back();
     return figures;
 }
@@ -597,7 +592,7 @@ int run(const Options& options) {
         std::printf("scrapes %llu ok, %llu failed%s%s; %zu bytes each; scrape latency p50 %.2f ms, max %.2f ms\n",
                     static_cast<unsigned long long>(scrapes.ok), static_cast<unsigned long long>(scrapes.failed),
                     scrapes.failure.empty() ? "" : ": ", scrapes.failure.c_str(), scrapes.last_bytes,
-                    percentile(scrapes.latency_us, 0.5) / 1000.0,
+                    bench::percentile_of_sorted(scrapes.latency_us, 0.5) / 1000.0,
                     scrapes.latency_us.empty() ? 0.0 : scrapes.latency_us.back() / 1000.0);
         std::printf("daemon CPU per serial transaction: %.1f us scraped, %.1f us (2c) unscraped; floor %.1f us\n",
                     scraped.cpu_us, again.cpu_us, floor_cpu);
@@ -624,8 +619,8 @@ int run(const Options& options) {
         std::uint64_t reader_errors = 0;
         for (const auto& reader : readers) reader_errors += reader.errors + (reader.failure.empty() ? 0 : 1);
         std::sort(writes.latency_us.begin(), writes.latency_us.end());
-        const double w_p50 = percentile(writes.latency_us, 0.50) / 1000.0;
-        const double w_p99 = percentile(writes.latency_us, 0.99) / 1000.0;
+        const double w_p50 = bench::percentile_of_sorted(writes.latency_us, 0.50) / 1000.0;
+        const double w_p99 = bench::percentile_of_sorted(writes.latency_us, 0.99) / 1000.0;
         const double w_max = writes.latency_us.empty() ? 0.0 : writes.latency_us.back() / 1000.0;
         const double line_rate = static_cast<double>(c_requests) / c_seconds;
         std::printf("== fb_bench_tcp_daemon (3) write latency: 16 clients reading, one writing FC06 every 30-50 ms, "

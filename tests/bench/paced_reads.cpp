@@ -1,5 +1,7 @@
 #include "paced_reads.hpp"
 
+#include "percentile.hpp"
+
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -63,12 +65,6 @@ struct Connection {
     std::array<std::uint8_t, 260> rx{};
     std::size_t rx_size = 0;
 };
-
-double percentile_of(const std::vector<double>& sorted, double p) {
-    if (sorted.empty()) return 0.0;
-    const auto rank = static_cast<std::size_t>(p * static_cast<double>(sorted.size() - 1) + 0.5);
-    return sorted[std::min(rank, sorted.size() - 1)];
-}
 
 timespec timeout_of(Clock::duration d) {
     const auto ns = std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(d).count());
@@ -186,10 +182,10 @@ PacedFigures run_paced_reads(const PacedLoad& load) {
     std::sort(latency.begin(), latency.end());
     std::sort(service.begin(), service.end());
     figures.reads = latency.size();
-    figures.p50_us = percentile_of(latency, 0.50);
-    figures.p99_us = percentile_of(latency, 0.99);
+    figures.p50_us = percentile_of_sorted(latency, 0.50);
+    figures.p99_us = percentile_of_sorted(latency, 0.99);
     figures.max_us = latency.empty() ? 0.0 : latency.back();
-    figures.service_p99_us = percentile_of(service, 0.99);
+    figures.service_p99_us = percentile_of_sorted(service, 0.99);
     return figures;
 }
 

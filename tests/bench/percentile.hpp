@@ -1,0 +1,17 @@
+#pragma once
+/// @file percentile.hpp
+/// The benchmarks' one percentile: nearest rank over an already sorted sample.
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace fieldbridge::bench {
+
+/// The value at fraction @p p (0..1) of @p sorted (ascending), nearest rank; 0 when empty.
+[[nodiscard]] inline double percentile_of_sorted(const std::vector<double>& sorted, double p) {
+    if (sorted.empty()) return 0.0;
+    const auto rank = static_cast<std::size_t>(p * static_cast<double>(sorted.size() - 1) + 0.5);
+    return sorted[std::min(rank, sorted.size() - 1)];
+}
+
+}  // namespace fieldbridge::bench
