@@ -6,9 +6,9 @@ namespace fieldbridge::app {
 
 engine::LogSink engine_log_sink(std::shared_ptr<spdlog::logger> logger) {
     engine::LogSink sink;
-    // The sink's threshold follows the logger's level at each call (a reload may
-    // change it), so it lets everything through and the logger decides.
-    sink.min_level = engine::LogLevel::debug;
+    // The sink's threshold is the logger's level at each call (a reload may change
+    // it): a message the logger would drop is not even built.
+    sink.accepts = [logger](engine::LogLevel level) { return logger->should_log(daemon::to_spdlog_level(level)); };
     sink.write = [logger = std::move(logger)](engine::LogLevel level, std::string_view message) {
         logger->log(daemon::to_spdlog_level(level), "{}", message);
     };

@@ -20,9 +20,15 @@ using core::to_string;
 struct LogSink {
     std::function<void(LogLevel, std::string_view)> write;
     LogLevel min_level = LogLevel::info;
+    /// When set, decides instead of min_level, at each call: the daemon's sink asks
+    /// its logger, whose level a reload may change. Without it a sink that let every
+    /// level through would have the engine build a debug line per state change of
+    /// every transaction only for the logger to drop it.
+    std::function<bool(LogLevel)> accepts = {};
 
     [[nodiscard]] bool enabled(LogLevel level) const noexcept {
-        return write && level >= min_level;
+        if (!write) return false;
+        return accepts ? accepts(level) : level >= min_level;
     }
     void operator()(LogLevel level, std::string_view message) const {
         if (enabled(level)) write(level, message);
