@@ -6,16 +6,22 @@
 //   fb_bench_line [seconds=5] [writes=200] [baud=115200]
 //
 //   a. line utilisation: 16 on-demand FC04 0x0300 x2 reads kept outstanding
-//      (max_age 0), completed transactions/s against 1 / T_line;
-//   b. command latency: the same saturating reads plus one FC16 write every
-//      30-50 ms (random phase), submit -> answer latency against the priority ideal;
-//   c. CPU per serial transaction: getrusage(RUSAGE_SELF) over run (a), three
-//      windows, the median;
-//   0. first, the floor: the same reads from a minimal master on raw system calls
-//      (raw_master.hpp) against the same simulator, for the same time: what this
-//      machine, its pseudo-terminals and the simulator allow at best; every line
-//      figure is printed as a ratio to the physical limit and to it. It also checks
-//      the simulator's physics from the master's side (floor_report.hpp).
+//      (max_age 0), completed transactions/s against 1 / T_line and against the
+//      floor;
+//   c. CPU per serial transaction: getrusage(RUSAGE_SELF) over each window of (a);
+//   0. the floor: the same reads from a minimal master on raw system calls
+//      (raw_master.hpp) against a second line of the same simulator (line-floor),
+//      what this machine, its pseudo-terminals and the simulator allow at best.
+//      (a)/(c) and the floor alternate (floor_pairs.hpp): three pairs of a floor
+//      window (the engine idle: its reads stopped and drained, its polls 60 min
+//      apart) and then an engine window on line-a (the 16 reads resumed, 200 ms of
+//      warm-up), each `seconds` long. Every pair is printed with its two ratios; the
+//      figures are the medians of the pairs' ratios, since this machine's CPU per
+//      transaction moves twofold from minute to minute. The simulator's physics is
+//      checked from the master's side over the first floor window
+//      (floor_report.hpp);
+//   b. command latency: then the same saturating reads plus one FC16 write every
+//      30-50 ms (random phase), submit -> answer latency against the priority ideal.
 //
 // The simulator binary is named by FIELDBRIDGE_SIM (run-benchmarks sets it); it is a
 // separate process, so the CPU figure is the gateway side alone (engine, scheduler,
@@ -36,9 +42,11 @@
 
 #include <fmt/format.h>
 
+#include "floor_pairs.hpp"
 #include "floor_report.hpp"
 #include "line_limit.hpp"
 #include "load_shape.hpp"
+#include "percentile.hpp"
 #include "process_cpu.hpp"
 #include "raw_master.hpp"
 #include "engine_harness.hpp"
@@ -60,28 +68,26 @@ constexpr std::uint16_t speed_address = 0x0631;   // "move: speed": a parameter,
 
 double ms(Clock::duration d) { return duration<double, std::milli>(d).count(); }
 
-double percentile(std::vector<double> values, double p) {
-    if (values.empty()) return 0.0;
-    std::sort(values.begin(), values.end());
-    const auto rank = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1) + 0.5);
-    return values[std::min(rank, values.size() - 1)];
-}
-
 /// Keeps a fixed number of status reads queued on one device: each answer submits the
-/// next, so the line never runs dry.
+/// next, so the line never runs dry. stop() lets the outstanding reads finish without
+/// submitting more (in_flight() tells when they have); start() again resumes.
 class ReadLoad {
 public:
     explicit ReadLoad(engine::DeviceAgent& agent) : agent_(agent) {}
     void start(unsigned count) {
+        stopping_ = false;
         for (unsigned i = 0; i < count; ++i) submit();
     }
     void stop() { stopping_ = true; }
     [[nodiscard]] std::uint64_t completed() const noexcept { return completed_; }
     [[nodiscard]] std::uint64_t failed() const noexcept { return failed_; }
+    [[nodiscard]] unsigned in_flight() const noexcept { return in_flight_; }
 
 private:
     void submit() {
+        ++in_flight_;
         agent_.request(integration::read_input(status_address, 2), [this](const protocol::Response& response) {
+            --in_flight_;
             if (integration::registers_of(response).size() == 2) {
                 ++completed_;
             } else {
@@ -93,6 +99,7 @@ private:
 
     engine::DeviceAgent& agent_;
     bool stopping_ = false;
+    unsigned in_flight_ = 0;
     std::uint64_t completed_ = 0;
     std::uint64_t failed_ = 0;
 };
@@ -132,17 +139,9 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
     const double t_write = limit.t_write_ms;
     const double limit_tps = limit.limit_tps;
 
-    SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--wire-time", "--baud", std::to_string(baud),
-                    "--turnaround", "1ms"});
-
-    // ---- 0: the floor ---------------------------------------------------------------
-    const bench::RawMasterResult floor = bench::run_raw_master(
-        bench::RawMasterSetup{sim.path("line-a"), shape, baud, turnaround, duration<double>(run_seconds)});
-    const double floor_tps = bench::floor_rate(floor);
-    const double floor_cpu = bench::floor_cpu_us(floor);
-    std::printf("== fb_bench_line (0) floor: minimal raw-syscall master, same reads, same simulator, %u bit/s ==\n",
-                baud);
-    bench::print_floor("fb_bench_line", floor, limit);
+    // line-a for the engine, line-floor (the same device) for the floor.
+    SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-floor:hiwin-xeg@2", "--wire-time",
+                    "--baud", std::to_string(baud), "--turnaround", "1ms"});
 
     EngineHarness h(engine_yaml(sim.path("line-a"), baud));
     h.start();
@@ -152,45 +151,74 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
         return 1;
     }
 
-    // ---- a + c: utilisation and CPU ----------------------------------------------
+    // ---- 0, a, c: the floor and the engine in alternating windows --------------------
+    // One window of either moves by +-20 % (and the floor's CPU twofold between
+    // minutes) on this virtual machine with the same code: each pair is a floor window
+    // and the engine window right after it, every ratio is taken within its pair, and
+    // the figures are medians.
+    constexpr int pairs = 3;
+    const duration<double> window(run_seconds);
+    std::printf("== fb_bench_line (0, a, c) the floor (minimal raw-syscall master on line-floor, the engine idle) and "
+                "the engine (16 reads outstanding on line-a), %d alternating pairs of %.1f s windows, %u bit/s ==\n",
+                pairs, run_seconds, baud);
+    const auto counter = [](const nlohmann::json& bus, const char* name) { return bus.value(name, std::uint64_t{0}); };
     ReadLoad reads(xeg);
-    reads.start(outstanding_reads);
-    h.run_for(milliseconds{500});  // warm-up
-    // Three windows: the CPU figure of one 5 s window moves by +-20 % on a virtual
-    // machine with the same code (cache, host scheduling); each is printed, and the
-    // median is the figure.
-    constexpr int windows = 3;
-    const auto bus0 = sim.stats()["buses"]["line-a"];
-    const std::uint64_t done0 = reads.completed();
+    bench::FloorPairs floor_pairs;
     std::vector<double> window_tps;
     std::vector<double> window_cpu;
     double user_total = 0.0;
     double sys_total = 0.0;
-    const auto t0 = Clock::now();
-    for (int w = 0; w < windows; ++w) {
+    double elapsed = 0.0;
+    std::uint64_t transactions = 0;
+    std::uint64_t sim_requests = 0;
+    std::uint64_t sim_replies = 0;
+    for (int pair = 1; pair <= pairs; ++pair) {
+        // The engine is idle here: its reads drained (below), its polls 60 min apart,
+        // and its loop does not run while the floor has this thread.
+        const bench::RawMasterResult floor = bench::run_raw_master(
+            bench::RawMasterSetup{sim.path("line-floor"), shape, baud, turnaround, window});
+        if (pair == 1) {
+            std::printf("the first floor window:\n");
+            bench::print_floor("fb_bench_line", floor, limit);
+        }
+
+        reads.start(outstanding_reads);
+        h.run_for(milliseconds{200});  // warm-up
+        const auto bus0 = sim.stats()["buses"]["line-a"];
         const std::uint64_t before = reads.completed();
         const bench::CpuTimes cpu0 = bench::process_cpu();
         const auto w0 = Clock::now();
-        h.run_for(std::chrono::duration_cast<engine::Duration>(duration<double>(run_seconds)));
+        h.run_for(std::chrono::duration_cast<engine::Duration>(window));
         const auto w1 = Clock::now();
         const bench::CpuTimes cpu1 = bench::process_cpu();
-        const auto done = static_cast<double>(reads.completed() - before);
-        window_tps.push_back(done / duration<double>(w1 - w0).count());
-        window_cpu.push_back(((cpu1.user - cpu0.user) + (cpu1.sys - cpu0.sys)) * 1e6 / done);
+        const std::uint64_t done = reads.completed() - before;
+        const auto bus1 = sim.stats()["buses"]["line-a"];
+        reads.stop();
+        if (!h.run_until([&] { return reads.in_flight() == 0; }, seconds{5})) {
+            std::fprintf(stderr, "fb_bench_line: %u reads still outstanding 5 s after the window\n",
+                         reads.in_flight());
+            return 1;
+        }
+
+        const double seconds_in_window = duration<double>(w1 - w0).count();
+        const double cpu = (cpu1.user - cpu0.user) + (cpu1.sys - cpu0.sys);
+        window_tps.push_back(static_cast<double>(done) / seconds_in_window);
+        window_cpu.push_back(done > 0 ? cpu * 1e6 / static_cast<double>(done) : 0.0);
         user_total += cpu1.user - cpu0.user;
         sys_total += cpu1.sys - cpu0.sys;
+        elapsed += seconds_in_window;
+        transactions += done;
+        sim_requests += counter(bus1, "requests") - counter(bus0, "requests");
+        sim_replies += counter(bus1, "replies") - counter(bus0, "replies");
+        floor_pairs.add("fb_bench_line", "engine",
+                        bench::FloorPair{{bench::floor_rate(floor), bench::floor_cpu_us(floor)},
+                                         {window_tps.back(), window_cpu.back()}});
     }
-    const auto t1 = Clock::now();
-    const std::uint64_t done1 = reads.completed();
-    const auto bus1 = sim.stats()["buses"]["line-a"];
-
-    const double elapsed = duration<double>(t1 - t0).count();
-    const auto transactions = static_cast<double>(done1 - done0);
-    const double tps = transactions / elapsed;
-    std::vector<double> sorted_cpu = window_cpu;
-    std::sort(sorted_cpu.begin(), sorted_cpu.end());
-    const double cpu_us = sorted_cpu[windows / 2];
-    const auto counter = [](const nlohmann::json& bus, const char* name) { return bus.value(name, std::uint64_t{0}); };
+    const auto bus_end = sim.stats()["buses"]["line-a"];
+    const bench::WindowFigures engine_median = floor_pairs.median_gateway();
+    const bench::WindowFigures floor_median = floor_pairs.median_floor();
+    const double tps = engine_median.tps;
+    const double cpu_us = engine_median.cpu_us;
     const auto list = [](const std::vector<double>& values, const char* format) {
         std::string text;
         for (const double value : values) text += (text.empty() ? "" : ", ") + fmt::format(fmt::runtime(format), value);
@@ -200,32 +228,36 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
     std::printf("== fb_bench_line (a) line utilisation: 16 on-demand FC04 0x0300 x2 reads outstanding ==\n");
     std::printf("T_line (8 + 9 bytes, %u 8N1, 1 ms turnaround) = %.3f ms -> limit %.1f tx/s\n", baud, t_read,
                 limit_tps);
-    std::printf("completed %.0f reads in %.3f s = %.1f tx/s, ratio %.3f (target >= 0.95); failed %llu; "
-                "%.3f of the floor's rate; windows: %s tx/s\n",
-                transactions, elapsed, tps, tps / limit_tps, static_cast<unsigned long long>(reads.failed()),
-                floor_tps > 0.0 ? tps / floor_tps : 0.0, list(window_tps, "{:.1f}").c_str());
-    std::printf("simulator: %llu requests, %llu replies in the window; gap_violations total %llu (target 0), "
+    std::printf("completed %llu reads in %d windows, %.3f s; median window %.1f tx/s, ratio %.3f (target >= 0.95); "
+                "failed %llu; median pair ratio to the floor %.3f; windows: %s tx/s\n",
+                static_cast<unsigned long long>(transactions), pairs, elapsed, tps, tps / limit_tps,
+                static_cast<unsigned long long>(reads.failed()), floor_pairs.median_rate_ratio(),
+                list(window_tps, "{:.1f}").c_str());
+    std::printf("simulator: %llu requests, %llu replies in the windows; gap_violations total %llu (target 0), "
                 "min_silence_us %s, collisions %llu, utilization %s\n",
-                static_cast<unsigned long long>(counter(bus1, "requests") - counter(bus0, "requests")),
-                static_cast<unsigned long long>(counter(bus1, "replies") - counter(bus0, "replies")),
-                static_cast<unsigned long long>(counter(bus1, "gap_violations")),
-                bus1.contains("min_silence_us") ? bus1["min_silence_us"].dump().c_str() : "?",
-                static_cast<unsigned long long>(counter(bus1, "collisions")),
-                bus1.contains("utilization") ? bus1["utilization"].dump().c_str() : "?");
+                static_cast<unsigned long long>(sim_requests), static_cast<unsigned long long>(sim_replies),
+                static_cast<unsigned long long>(counter(bus_end, "gap_violations")),
+                bus_end.contains("min_silence_us") ? bus_end["min_silence_us"].dump().c_str() : "?",
+                static_cast<unsigned long long>(counter(bus_end, "collisions")),
+                bus_end.contains("utilization") ? bus_end["utilization"].dump().c_str() : "?");
     // Where the time between transactions goes: how late the simulator's replies left
     // (its own scheduling), against the silence the master actually kept.
-    const double per_tx_ms = elapsed * 1000.0 / transactions;
+    const double per_tx_ms = transactions > 0 ? elapsed * 1000.0 / static_cast<double>(transactions) : 0.0;
     std::printf("mean line time per transaction %.3f ms = T_line + %.3f ms; simulator reply lateness %s\n",
-                per_tx_ms, per_tx_ms - t_read, bus1.contains("timing") ? bus1["timing"].dump().c_str() : "?");
+                per_tx_ms, per_tx_ms - t_read, bus_end.contains("timing") ? bus_end["timing"].dump().c_str() : "?");
     std::printf("== fb_bench_line (c) CPU per serial transaction ==\n");
     std::printf("process CPU (user+sys) per transaction, median of %d windows = %.1f us/transaction (target <= 50); "
-                "windows: %s us; %.2fx the floor's %.1f us; user %.0f %% / kernel %.0f %% (tick-sampled split)\n",
-                windows, cpu_us, list(window_cpu, "{:.1f}").c_str(), floor_cpu > 0.0 ? cpu_us / floor_cpu : 0.0,
-                floor_cpu, 100.0 * user_total / (user_total + sys_total), 100.0 * sys_total / (user_total + sys_total));
+                "windows: %s us; median pair ratio to the floor %.2fx (target <= 1.3); user %.0f %% / kernel %.0f %% "
+                "(tick-sampled split)\n",
+                pairs, cpu_us, list(window_cpu, "{:.1f}").c_str(), floor_pairs.median_cpu_ratio(),
+                100.0 * user_total / (user_total + sys_total), 100.0 * sys_total / (user_total + sys_total));
     std::printf("summary: engine line rate xeg at %u bit/s: %.1f tx/s = %.3f of the limit (target >= 0.95), %.3f of "
-                "the floor (floor %.3f of the limit); CPU %.1f us/transaction = %.2fx the floor's %.1f us\n",
-                baud, tps, tps / limit_tps, floor_tps > 0.0 ? tps / floor_tps : 0.0, floor_tps / limit_tps, cpu_us,
-                floor_cpu > 0.0 ? cpu_us / floor_cpu : 0.0, floor_cpu);
+                "the floor (median of %zu pair ratios; floor median %.3f of the limit); CPU %.1f us/transaction "
+                "(median of %zu windows) = %.2fx the floor (median of the pair ratios, target <= 1.3; floor median "
+                "%.1f us)\n",
+                baud, tps, tps / limit_tps, floor_pairs.median_rate_ratio(), floor_pairs.size(),
+                floor_median.tps / limit_tps, cpu_us, floor_pairs.size(), floor_pairs.median_cpu_ratio(),
+                floor_median.cpu_us);
 
     // ---- b: command latency under saturating reads --------------------------------
     std::vector<double> latencies;
@@ -252,6 +284,8 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
             schedule();
         });
     };
+    reads.start(outstanding_reads);
+    h.run_for(milliseconds{200});  // warm-up
     const std::uint64_t b_done0 = reads.completed();
     const auto b0 = Clock::now();
     schedule();
@@ -265,9 +299,10 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
 
     const double ideal_p50 = t_write + t_read / 2.0;
     const double ideal_max = t_write + t_read;
-    const double p50 = percentile(latencies, 0.50);
-    const double p99 = percentile(latencies, 0.99);
-    const double max = latencies.empty() ? 0.0 : *std::max_element(latencies.begin(), latencies.end());
+    std::sort(latencies.begin(), latencies.end());
+    const double p50 = bench::percentile_of_sorted(latencies, 0.50);
+    const double p99 = bench::percentile_of_sorted(latencies, 0.99);
+    const double max = latencies.empty() ? 0.0 : latencies.back();
     std::printf("== fb_bench_line (b) write latency with 16 reads outstanding ==\n");
     std::printf("write FC16 x1 (11 + 8 bytes): T_write = %.3f ms; priority ideal p50 = T_write + T_read/2 = %.3f ms, "
                 "max = T_write + T_read = %.3f ms\n",

@@ -7,11 +7,14 @@
 //       [--shape=xeg|generic] [--baud=115200] [--clients=16[,8,...]]
 //       [--parts=cache,line,scrape,write] [--paced-runs=3]
 //
-//   0. the floor: first, for `seconds`, the minimal raw-syscall master
-//      (raw_master.hpp) reads the same shape on a line of the same simulator at the
-//      same baud: every line figure below is printed as a ratio to the physical
-//      limit and to this floor, and the simulator's physics is checked from the
-//      master's side;
+//   the floor: the minimal raw-syscall master (raw_master.hpp) reads the same shape
+//      on line-floor of the same simulator at the same baud, in windows of
+//      `seconds`/2 while the daemon is idle (no client runs; with `cache`, line-a's
+//      polls go on). Every line figure is printed as a ratio to the physical limit
+//      and to a floor window measured seconds before it, never minutes: this
+//      machine's CPU per transaction moves twofold from minute to minute. The
+//      simulator's physics is checked from the master's side over the first floor
+//      window (floor_report.hpp);
 //   cache, 1. cache-served reads: 32 clients (blocking sockets, one request
 //      outstanding each) read FC04 0x0300 x2 from unit 1 (line-a, one XEG, max_age
 //      10s, polled every 100 ms) flat out: reads/s, p50/p99, and the serial requests
@@ -21,11 +24,17 @@
 //      in this process first (the generator's own tail), then against the daemon;
 //      `--paced-runs` times each, alternated;
 //   line, 2. TCP -> line throughput: N clients (each of `--clients`) read the shape
-//      from line-b (max_age 0: every read goes to the line);
-//   scrape, 2b/2c. the first of those loads while /metrics is scraped every 100 ms,
-//      then once more without;
-//   write, 3. command latency under load: 16 clients saturate line-b while a 17th
-//      writes FC06 every 30-50 ms: send -> answer against the priority ideal.
+//      from line-b (max_age 0: every read goes to the line), in three alternating
+//      pairs (floor_pairs.hpp) of a floor window and then the clients' window, each
+//      `seconds`/2 long (half, to keep tests/bench/run-benchmarks' eight loads
+//      within minutes); every pair is printed with its rate and CPU ratios, and the
+//      summary gives the medians of the pair ratios;
+//   scrape, 2b/2c. a floor window, then the first of those loads for `seconds` while
+//      /metrics is scraped every 100 ms, then once more without; their ratios are to
+//      that floor window;
+//   write, 3. a floor window, then command latency under load: 16 clients saturate
+//      line-b while a 17th writes FC06 every 30-50 ms: send -> answer against the
+//      priority ideal; the line rate meanwhile against that floor window.
 //
 // Shapes (load_shape.hpp): `xeg`, one HIWIN XEG on line-b, FC04 0x0300 x2; `generic`,
 // four generic `modbus` devices on line-b, FC03 x2 at varying addresses.
@@ -65,6 +74,7 @@
 #include <fmt/format.h>
 
 #include "daemon_process.hpp"
+#include "floor_pairs.hpp"
 #include "floor_report.hpp"
 #include "line_limit.hpp"
 #include "load_shape.hpp"
@@ -265,11 +275,6 @@ void print_warnings(const std::string& log, const char* when) {
         }
     }
     if (total > shown) std::printf("daemon log %s: ... %d warnings/errors in all\n", when, total);
-}
-
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    return bench::percentile_of_sorted(values, 0.5);
 }
 
 /// Runs @p clients back-to-back clients for warm-up + @p seconds; @p in_window runs on
@@ -477,7 +482,7 @@ void run_cache(const Options& options, const integration::SimProcess& sim, const
     }
     std::printf("summary: cache reads paced at 50000/s, p99 from when due (target < 1000 us), median of %d runs: "
                 "daemon %.0f us, null server %.0f us\n",
-                options.paced_runs, median(daemon_p99), median(null_p99));
+                options.paced_runs, bench::median_of(daemon_p99), bench::median_of(null_p99));
     print_warnings(daemon.log_text(), "during (1b)");
 }
 
@@ -502,19 +507,7 @@ int run(const Options& options) {
                 std::string(shape.name()).c_str(), std::string(shape.description()).c_str(), options.baud,
                 limit.t_read_ms, limit.limit_tps, limit.t3_5_us);
 
-    // ---- 0: the floor, before the daemon runs -------------------------------------
     const bool line_parts = options.has("line") || options.has("scrape") || options.has("write");
-    bench::RawMasterResult floor;
-    if (line_parts) {
-        floor = bench::run_raw_master(
-            bench::RawMasterSetup{sim.path("line-floor"), shape, options.baud, turnaround, duration<double>(seconds)});
-        std::printf("== fb_bench_tcp_daemon (0) floor: minimal raw-syscall master, %s ==\n", label.c_str());
-        bench::print_floor("fb_bench_tcp_daemon", floor, limit);
-    }
-    const double floor_tps = bench::floor_rate(floor);
-    const double floor_cpu = bench::floor_cpu_us(floor);
-    const auto of_floor = [&](double tps) { return floor_tps > 0.0 ? tps / floor_tps : 0.0; };
-
     const std::uint16_t port = bench::free_loopback_port();
     const auto config_path = sim.dir() / "bench.yaml";
     const std::uint16_t metrics_port = bench::free_loopback_port();
@@ -523,14 +516,29 @@ int run(const Options& options) {
 
     if (options.has("cache")) run_cache(options, sim, daemon, port);
 
+    // ---- the floor: on line-floor while no client runs ------------------------------
+    const double pair_seconds = seconds / 2.0;
+    int floor_windows = 0;
+    const auto floor_window = [&] {
+        const bench::RawMasterResult floor = bench::run_raw_master(bench::RawMasterSetup{
+            sim.path("line-floor"), shape, options.baud, turnaround, duration<double>(pair_seconds)});
+        if (++floor_windows == 1) {
+            std::printf("the first floor window (minimal raw-syscall master on line-floor, %s, the daemon idle):\n",
+                        label.c_str());
+            bench::print_floor("fb_bench_tcp_daemon", floor, limit);
+        }
+        return bench::WindowFigures{bench::floor_rate(floor), bench::floor_cpu_us(floor)};
+    };
+    const auto ratio = [](double value, double floor) { return floor > 0.0 ? value / floor : 0.0; };
+
     const Target direct_target{shape, 2};
-    const auto line_b_load = [&](unsigned clients) {
+    const auto line_b_load = [&](unsigned clients, double window_seconds) {
         std::uint64_t r0 = 0;
         std::uint64_t r1 = 0;
         double cpu0 = 0.0;
         double cpu1 = 0.0;
         LineLoad load;
-        load.figures = run_load(port, direct_target, clients, seconds, [&](bool start) {
+        load.figures = run_load(port, direct_target, clients, window_seconds, [&](bool start) {
             (start ? r0 : r1) = bus_counter(sim, "line-b", "requests");
             (start ? cpu0 : cpu1) = daemon.cpu_seconds();
         });
@@ -541,49 +549,58 @@ int run(const Options& options) {
     };
     if (line_parts) std::this_thread::sleep_for(milliseconds{500});  // the generic blocks' first reads
 
-    // ---- 2: TCP -> line throughput ------------------------------------------------
-    std::vector<LineLoad> unscraped;
+    // ---- 2: TCP -> line throughput, alternating with the floor ----------------------
+    constexpr int pairs = 3;
+    std::vector<double> unscraped_rates;  // the median rate of each client count
     if (options.has("line") || options.has("scrape")) {
         for (const unsigned clients : options.clients) {
-            unscraped.push_back(line_b_load(clients));
-            const LineLoad& load = unscraped.back();
-            const auto& f = load.figures;
-            std::printf("== fb_bench_tcp_daemon (2) TCP -> line: %u clients, %s, max_age 0 ==\n", clients,
-                        label.c_str());
-            std::printf("%llu reads answered in %.1f s = %.1f tx/s; errors %llu%s%s\n",
-                        static_cast<unsigned long long>(f.reads), f.seconds, load.rate,
-                        static_cast<unsigned long long>(f.errors), f.failures.empty() ? "" : "; client failures: ",
-                        f.failures.c_str());
-            if (!f.exceptions.empty()) std::printf("exception replies: %s\n", f.exceptions.c_str());
-            std::printf("simulator line-b requests in the window: %llu = %.1f/s\n",
-                        static_cast<unsigned long long>(load.requests),
-                        static_cast<double>(load.requests) / f.seconds);
-            std::printf("latency p50 %.2f ms, p99 %.2f ms, max %.2f ms\n", f.p50_us / 1000.0, f.p99_us / 1000.0,
-                        f.max_us / 1000.0);
-            std::printf("summary: TCP->line %s, %u clients: %.1f tx/s = %.3f of the limit (target >= 0.95), %.3f of "
-                        "the floor (floor %.3f of the limit); daemon CPU %.1f us/transaction = %.2fx the floor's "
-                        "%.1f us\n",
-                        label.c_str(), clients, load.rate, load.rate / limit.limit_tps, of_floor(load.rate),
-                        floor_tps / limit.limit_tps, load.cpu_us, floor_cpu > 0.0 ? load.cpu_us / floor_cpu : 0.0,
-                        floor_cpu);
+            std::printf("== fb_bench_tcp_daemon (2) TCP -> line: %u clients, %s, max_age 0; %d alternating pairs of "
+                        "%.1f s windows: the floor on line-floor (no client running), then the clients on line-b ==\n",
+                        clients, label.c_str(), pairs, pair_seconds);
+            bench::FloorPairs floor_pairs;
+            for (int pair = 1; pair <= pairs; ++pair) {
+                const bench::WindowFigures floor = floor_window();
+                const LineLoad load = line_b_load(clients, pair_seconds);
+                const auto& f = load.figures;
+                std::printf("pair %d daemon window: %llu reads answered in %.1f s = %.1f tx/s; errors %llu%s%s; "
+                            "simulator line-b requests %.1f/s; latency p50 %.2f ms, p99 %.2f ms, max %.2f ms\n",
+                            pair, static_cast<unsigned long long>(f.reads), f.seconds, load.rate,
+                            static_cast<unsigned long long>(f.errors), f.failures.empty() ? "" : "; client failures: ",
+                            f.failures.c_str(), static_cast<double>(load.requests) / f.seconds, f.p50_us / 1000.0,
+                            f.p99_us / 1000.0, f.max_us / 1000.0);
+                if (!f.exceptions.empty()) std::printf("exception replies: %s\n", f.exceptions.c_str());
+                floor_pairs.add("fb_bench_tcp_daemon", "daemon", bench::FloorPair{floor, {load.rate, load.cpu_us}});
+            }
+            const bench::WindowFigures daemon_median = floor_pairs.median_gateway();
+            const bench::WindowFigures floor_median = floor_pairs.median_floor();
+            unscraped_rates.push_back(daemon_median.tps);
+            std::printf("summary: TCP->line %s, %u clients: %.1f tx/s (median of %zu windows) = %.3f of the limit "
+                        "(target >= 0.95), %.3f of the floor (median of the pair ratios, target >= 0.98; floor median "
+                        "%.3f of the limit); daemon CPU %.1f us/transaction (median) = %.2fx the floor (median of the "
+                        "pair ratios, target <= 2; floor median %.1f us)\n",
+                        label.c_str(), clients, daemon_median.tps, floor_pairs.size(),
+                        daemon_median.tps / limit.limit_tps, floor_pairs.median_rate_ratio(),
+                        floor_median.tps / limit.limit_tps, daemon_median.cpu_us, floor_pairs.median_cpu_ratio(),
+                        floor_median.cpu_us);
         }
     }
 
     // ---- 2b/2c: the same load with and without scraping /metrics ---------------------
-    if (options.has("scrape") && !unscraped.empty()) {
+    if (options.has("scrape") && !unscraped_rates.empty()) {
         const unsigned clients = options.clients.front();
+        const bench::WindowFigures floor = floor_window();
         bench::MetricsScraper scraper(metrics_port, milliseconds{100});
-        const LineLoad scraped = line_b_load(clients);
+        const LineLoad scraped = line_b_load(clients, seconds);
         const auto scrapes = scraper.stop();
-        const LineLoad again = line_b_load(clients);
-        const double first_rate = unscraped.front().rate;
+        const LineLoad again = line_b_load(clients, seconds);
+        const double first_rate = unscraped_rates.front();
         const double mean = (first_rate + again.rate) / 2.0;
         std::printf("== fb_bench_tcp_daemon (2b) TCP -> line (%u clients) while GET /metrics every 100 ms; (2c) "
-                    "again without ==\n",
-                    clients);
+                    "again without; both beside the floor window just before (2b): %.1f tx/s, %.1f us/tx ==\n",
+                    clients, floor.tps, floor.cpu_us);
         std::printf("scraped %.1f tx/s (%.3f of the limit, %.3f of the floor; p99 %.2f ms, errors %llu); unscraped "
-                    "(2) %.1f and (2c) %.1f tx/s\n",
-                    scraped.rate, scraped.rate / limit.limit_tps, of_floor(scraped.rate),
+                    "(2, median) %.1f and (2c) %.1f tx/s\n",
+                    scraped.rate, scraped.rate / limit.limit_tps, ratio(scraped.rate, floor.tps),
                     scraped.figures.p99_us / 1000.0, static_cast<unsigned long long>(scraped.figures.errors),
                     first_rate, again.rate);
         std::printf("summary: scraping cost: line rate %+.2f%% against the unscraped mean; unscraped runs differ by "
@@ -594,12 +611,15 @@ int run(const Options& options) {
                     scrapes.failure.empty() ? "" : ": ", scrapes.failure.c_str(), scrapes.last_bytes,
                     bench::percentile_of_sorted(scrapes.latency_us, 0.5) / 1000.0,
                     scrapes.latency_us.empty() ? 0.0 : scrapes.latency_us.back() / 1000.0);
-        std::printf("daemon CPU per serial transaction: %.1f us scraped, %.1f us (2c) unscraped; floor %.1f us\n",
-                    scraped.cpu_us, again.cpu_us, floor_cpu);
+        std::printf("daemon CPU per serial transaction: %.1f us scraped (%.2fx the floor), %.1f us (2c) unscraped "
+                    "(%.2fx the floor)\n",
+                    scraped.cpu_us, ratio(scraped.cpu_us, floor.cpu_us), again.cpu_us,
+                    ratio(again.cpu_us, floor.cpu_us));
     }
 
     // ---- 3: a write's latency while 16 clients saturate the line ------------------
     if (options.has("write")) {
+        const bench::WindowFigures floor = floor_window();
         std::atomic<bool> stop_readers{false};
         std::vector<ClientResult> readers(16);
         std::vector<std::thread> reader_threads;
@@ -630,10 +650,11 @@ int run(const Options& options) {
                     shape.write_request_bytes(), shape.write_reply_bytes(), limit.t_write_ms,
                     limit.write_ideal_p50_ms(), limit.write_ideal_max_ms());
         std::printf("%zu writes ok, %llu failed%s%s; line-b meanwhile %.1f requests/s (%.3f of the limit, %.3f of "
-                    "the floor); reader errors %llu\n",
+                    "the floor window just before (3): %.1f tx/s); reader errors %llu\n",
                     writes.latency_us.size(), static_cast<unsigned long long>(writes.errors),
                     writes.failure.empty() ? "" : "; writer stopped: ", writes.failure.c_str(), line_rate,
-                    line_rate / limit.limit_tps, of_floor(line_rate), static_cast<unsigned long long>(reader_errors));
+                    line_rate / limit.limit_tps, ratio(line_rate, floor.tps), floor.tps,
+                    static_cast<unsigned long long>(reader_errors));
         std::printf("write latency p50 %.3f ms, p99 %.3f ms, max %.3f ms\n", w_p50, w_p99, w_max);
         std::printf("summary: TCP write %s under 16 readers: p50 %.3f ms = %.2fx the priority ideal (target <= 1.2), "
                     "max %.3f ms = %.2fx (target <= 1.5)\n",

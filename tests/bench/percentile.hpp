@@ -1,6 +1,7 @@
 #pragma once
 /// @file percentile.hpp
-/// The benchmarks' one percentile: nearest rank over an already sorted sample.
+/// The benchmarks' one percentile: nearest rank over an already sorted sample, and
+/// the median of an unsorted one.
 #include <algorithm>
 #include <cstddef>
 #include <vector>
@@ -12,6 +13,12 @@ namespace fieldbridge::bench {
     if (sorted.empty()) return 0.0;
     const auto rank = static_cast<std::size_t>(p * static_cast<double>(sorted.size() - 1) + 0.5);
     return sorted[std::min(rank, sorted.size() - 1)];
+}
+
+/// The median of @p values (any order), nearest rank; 0 when empty.
+[[nodiscard]] inline double median_of(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    return percentile_of_sorted(values, 0.5);
 }
 
 }  // namespace fieldbridge::bench
