@@ -145,6 +145,9 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
 
     EngineHarness h(engine_yaml(sim.path("line-a"), baud));
     h.start();
+    // The floor keeps the silence the way the engine's line does: slept out, or with
+    // precise_timing slept to the lead and spun (raw_master.hpp).
+    const engine::Duration spin_lead = h.engine().lines().front().worker->config().spin_lead;
     auto& xeg = h.device("xeg");
     if (!h.run_until([&] { return xeg.online(); }, seconds{5})) {
         std::fprintf(stderr, "fb_bench_line: the XEG did not come online within 5 s\n%s\n", sim.log_text().c_str());
@@ -176,7 +179,7 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
         // The engine is idle here: its reads drained (below), its polls 60 min apart,
         // and its loop does not run while the floor has this thread.
         const bench::RawMasterResult floor = bench::run_raw_master(
-            bench::RawMasterSetup{sim.path("line-floor"), shape, baud, turnaround, window});
+            bench::RawMasterSetup{sim.path("line-floor"), shape, baud, turnaround, window, spin_lead});
         if (pair == 1) {
             std::printf("the first floor window:\n");
             bench::print_floor("fb_bench_line", floor, limit);

@@ -73,6 +73,7 @@
 
 #include <fmt/format.h>
 
+#include "config/validate.hpp"
 #include "daemon_process.hpp"
 #include "floor_pairs.hpp"
 #include "floor_report.hpp"
@@ -518,10 +519,17 @@ int run(const Options& options) {
 
     // ---- the floor: on line-floor while no client runs ------------------------------
     const double pair_seconds = seconds / 2.0;
+    // The floor keeps the silence the way line-b does: its precise_timing is the
+    // default for the baud (no turnaround set), so the floor spins when it does.
+    config::LineConfig line_b;
+    line_b.baud = options.baud;
+    const std::chrono::nanoseconds floor_spin_lead =
+        config::default_precise_timing(line_b) ? std::chrono::nanoseconds{config::LineConfig::precise_timing_lead}
+                                               : std::chrono::nanoseconds::zero();
     int floor_windows = 0;
     const auto floor_window = [&] {
         const bench::RawMasterResult floor = bench::run_raw_master(bench::RawMasterSetup{
-            sim.path("line-floor"), shape, options.baud, turnaround, duration<double>(pair_seconds)});
+            sim.path("line-floor"), shape, options.baud, turnaround, duration<double>(pair_seconds), floor_spin_lead});
         if (++floor_windows == 1) {
             std::printf("the first floor window (minimal raw-syscall master on line-floor, %s, the daemon idle):\n",
                         label.c_str());

@@ -1,6 +1,7 @@
 #include "floor_report.hpp"
 
 #include <cstdio>
+#include <string>
 
 namespace fieldbridge::bench {
 
@@ -27,9 +28,15 @@ void print_floor(const char* bench, const RawMasterResult& floor, const LineLimi
                 static_cast<unsigned long long>(floor.early_replies),
                 static_cast<unsigned long long>(floor.transactions), model_ms,
                 (floor.reply_median_ms - model_ms) * 1e3);
+    const std::string method =
+        floor.spin_lead_us > 0.0
+            ? "slept to " + std::to_string(static_cast<long>(floor.spin_lead_us)) +
+                  " us before its end, then spun, as precise_timing does"
+            : std::string("slept with clock_nanosleep()");
     std::printf("%s physics: the master's silence from the reply read to its next write: min %.0f us, "
-                "median %.0f us, p99 %.0f us (t3.5 = %.0f us)\n",
-                bench, floor.silence_min_us, floor.silence_median_us, floor.silence_p99_us, limit.t3_5_us);
+                "median %.0f us, p99 %.0f us (t3.5 = %.0f us; %s)\n",
+                bench, floor.silence_min_us, floor.silence_median_us, floor.silence_p99_us, limit.t3_5_us,
+                method.c_str());
 }
 
 }  // namespace fieldbridge::bench

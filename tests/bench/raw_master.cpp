@@ -66,6 +66,7 @@ RawMasterResult run_raw_master(const RawMasterSetup& setup) {
 
     RawPort port(setup.path);
     RawMasterResult result;
+    result.spin_lead_us = std::chrono::duration<double, std::micro>(setup.spin_lead).count();
     result.reply_bound_ms = std::chrono::duration<double, std::milli>(bound).count();
     const CpuTimes cpu0 = process_cpu();
     const auto start = Clock::now();
@@ -104,7 +105,17 @@ RawMasterResult run_raw_master(const RawMasterSetup& setup) {
         } else {
             ++result.timeouts;
         }
-        sleep_until(last_reply + timing.t3_5());
+        const auto silence_end = last_reply + timing.t3_5();
+        if (setup.spin_lead > std::chrono::nanoseconds::zero()) {
+            if (silence_end - Clock::now() > setup.spin_lead) sleep_until(silence_end - setup.spin_lead);
+            while (Clock::now() < silence_end) {
+#if defined(__x86_64__) || defined(__i386__)
+                __builtin_ia32_pause();
+#endif
+            }
+        } else {
+            sleep_until(silence_end);
+        }
     }
     const CpuTimes cpu1 = process_cpu();
     result.seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -2,7 +2,8 @@
 /// @file raw_master.hpp
 /// The floor of the line benchmarks: the smallest possible Modbus-RTU master, written
 /// straight on the system calls (write the request, poll() for the reply, read it,
-/// clock_nanosleep() the 3.5-character silence from the moment it was read, again).
+/// clock_nanosleep() the 3.5-character silence from the moment it was read, again;
+/// with a spin lead, sleep to the lead before the silence's end and busy-wait the rest).
 /// It has no event loop, scheduler, register image or error handling worth the name;
 /// what it costs per transaction on this machine is what the kernel, the
 /// pseudo-terminal and the simulator process cost, and what it achieves is what the
@@ -28,6 +29,10 @@ struct RawMasterSetup {
     std::uint32_t baud = 115200;  ///< 8N1
     std::chrono::nanoseconds turnaround = std::chrono::milliseconds{1};  ///< the simulator's
     std::chrono::duration<double> duration{5.0};
+    /// Zero: the silence is slept out with clock_nanosleep(). Otherwise the master
+    /// sleeps until this long before the silence ends and spins to the instant, as the
+    /// gateway does with `precise_timing` (the floor of that mode).
+    std::chrono::nanoseconds spin_lead{0};
 };
 
 struct RawMasterResult {
@@ -50,6 +55,7 @@ struct RawMasterResult {
     double silence_min_us = 0.0;
     double silence_median_us = 0.0;
     double silence_p99_us = 0.0;
+    double spin_lead_us = 0.0;  ///< RawMasterSetup::spin_lead: 0 when the silence was slept
 };
 
 /// Runs the reads of @p setup.shape on @p setup.path until @p setup.duration has
