@@ -1,6 +1,7 @@
 #include "paced_reads.hpp"
 
 #include "percentile.hpp"
+#include "unique_fd.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -23,21 +24,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 /// Owns a file descriptor.
-class Fd {
-public:
-    explicit Fd(int fd) : fd_(fd) {}
-    ~Fd() {
-        if (fd_ >= 0) ::close(fd_);
-    }
-    Fd(Fd&& other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
-    Fd& operator=(Fd&&) = delete;
-    Fd(const Fd&) = delete;
-    Fd& operator=(const Fd&) = delete;
-    [[nodiscard]] int get() const noexcept { return fd_; }
-
-private:
-    int fd_;
-};
+using Fd = test_support::UniqueFd;
 
 Fd connect_loopback(std::uint16_t port) {
     Fd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));

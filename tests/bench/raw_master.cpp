@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engine/line_timing.hpp"
+#include "percentile.hpp"
 #include "process_cpu.hpp"
 #include "protocol/rtu_frame.hpp"
 
@@ -48,10 +49,6 @@ void sleep_until(Clock::time_point until) {
     const timespec ts{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
     while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
     }
-}
-
-double sorted_at(const std::vector<double>& sorted, double p) {
-    return sorted[std::min(sorted.size() - 1, static_cast<std::size_t>(static_cast<double>(sorted.size()) * p))];
 }
 
 }  // namespace
@@ -125,14 +122,14 @@ RawMasterResult run_raw_master(const RawMasterSetup& setup) {
         result.sys_cpu_us = (cpu1.sys - cpu0.sys) * 1e6 / count;
         std::sort(reply_ms.begin(), reply_ms.end());
         result.reply_min_ms = reply_ms.front();
-        result.reply_median_ms = sorted_at(reply_ms, 0.5);
-        result.reply_p99_ms = sorted_at(reply_ms, 0.99);
+        result.reply_median_ms = percentile_of_sorted(reply_ms, 0.5);
+        result.reply_p99_ms = percentile_of_sorted(reply_ms, 0.99);
     }
     if (!silence_us.empty()) {
         std::sort(silence_us.begin(), silence_us.end());
         result.silence_min_us = silence_us.front();
-        result.silence_median_us = sorted_at(silence_us, 0.5);
-        result.silence_p99_us = sorted_at(silence_us, 0.99);
+        result.silence_median_us = percentile_of_sorted(silence_us, 0.5);
+        result.silence_p99_us = percentile_of_sorted(silence_us, 0.99);
     }
     return result;
 }

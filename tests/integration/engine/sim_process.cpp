@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <thread>
 #include "temp_dir.hpp"
+#include "unique_fd.hpp"
 
 extern char** environ;
 
@@ -29,21 +30,7 @@ using std::chrono::milliseconds;
 std::string errno_text(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
 
 /// Owns a file descriptor.
-class Fd {
-public:
-    explicit Fd(int fd = -1) noexcept : fd_(fd) {}
-    ~Fd() { reset(); }
-    Fd(const Fd&) = delete;
-    Fd& operator=(const Fd&) = delete;
-    [[nodiscard]] int get() const noexcept { return fd_; }
-    void reset() noexcept {
-        if (fd_ >= 0) ::close(fd_);
-        fd_ = -1;
-    }
-
-private:
-    int fd_;
-};
+using Fd = test_support::UniqueFd;
 
 std::string sim_binary() {
     const char* path = std::getenv("FIELDBRIDGE_SIM");
