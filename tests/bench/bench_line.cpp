@@ -305,10 +305,10 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
 
     const double ideal_p50 = t_write + t_read / 2.0;
     const double ideal_max = t_write + t_read;
-    std::sort(latencies.begin(), latencies.end());
-    const double p50 = bench::percentile_of_sorted(latencies, 0.50);
-    const double p99 = bench::percentile_of_sorted(latencies, 0.99);
-    const double max = latencies.empty() ? 0.0 : latencies.back();
+    const bench::Spread latency = bench::spread_of(latencies);
+    const double p50 = latency.p50;
+    const double p99 = latency.p99;
+    const double max = latency.max;
     std::printf("== fb_bench_line (b) write latency with 16 reads outstanding ==\n");
     std::printf("write FC16 x1 (11 + 8 bytes): T_write = %.3f ms; priority ideal p50 = T_write + T_read/2 = %.3f ms, "
                 "max = T_write + T_read = %.3f ms\n",

@@ -453,10 +453,10 @@ int run(const Options& options) {
         for (auto& thread : reader_threads) thread.join();
         std::uint64_t reader_errors = 0;
         for (const auto& reader : readers) reader_errors += reader.errors + (reader.failure.empty() ? 0 : 1);
-        std::sort(writes.latency_us.begin(), writes.latency_us.end());
-        const double w_p50 = bench::percentile_of_sorted(writes.latency_us, 0.50) / 1000.0;
-        const double w_p99 = bench::percentile_of_sorted(writes.latency_us, 0.99) / 1000.0;
-        const double w_max = writes.latency_us.empty() ? 0.0 : writes.latency_us.back() / 1000.0;
+        const bench::Spread write_latency = bench::spread_of(writes.latency_us);
+        const double w_p50 = write_latency.p50 / 1000.0;
+        const double w_p99 = write_latency.p99 / 1000.0;
+        const double w_max = write_latency.max / 1000.0;
         const double line_rate = static_cast<double>(c_requests) / c_seconds;
         std::printf("== fb_bench_tcp_daemon (3) write latency: 16 clients reading, one writing FC06 every 30-50 ms, "
                     "%s ==\n",

@@ -55,14 +55,8 @@ void StallProbe::run() {
 StallFigures StallProbe::stop() {
     stopping_ = true;
     if (thread_.joinable()) thread_.join();
-    std::vector<double> sorted = late_us_;
-    std::sort(sorted.begin(), sorted.end());
-    StallFigures figures;
-    figures.wakeups = sorted.size();
-    figures.p50_us = percentile_of_sorted(sorted, 0.50);
-    figures.p99_us = percentile_of_sorted(sorted, 0.99);
-    figures.max_us = sorted.empty() ? 0.0 : sorted.back();
-    return figures;
+    const Spread late = spread_of(late_us_);
+    return StallFigures{late.count, late.p50, late.p99, late.max};
 }
 
 }  // namespace fieldbridge::bench

@@ -183,11 +183,11 @@ LoadFigures run_load(std::uint16_t port, Target target, unsigned clients, double
         if (!figures.exceptions.empty()) figures.exceptions += ", ";
         figures.exceptions += fmt::format("0x{:02X} x {}", code, exceptions[code]);
     }
-    std::sort(all.begin(), all.end());
-    figures.reads = all.size();
-    figures.p50_us = percentile_of_sorted(all, 0.50);
-    figures.p99_us = percentile_of_sorted(all, 0.99);
-    figures.max_us = all.empty() ? 0.0 : all.back();
+    const Spread latency = spread_of(std::move(all));
+    figures.reads = latency.count;
+    figures.p50_us = latency.p50;
+    figures.p99_us = latency.p99;
+    figures.max_us = latency.max;
     return figures;
 }
 
