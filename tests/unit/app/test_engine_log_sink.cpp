@@ -6,7 +6,6 @@
 #include <string>
 
 #include "app/engine_component.hpp"
-#include "daemon/logging.hpp"
 
 namespace fe = fieldbridge::engine;
 
