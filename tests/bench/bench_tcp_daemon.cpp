@@ -332,9 +332,11 @@ int run(const Options& options) {
         config::default_precise_timing(line_b) ? std::chrono::nanoseconds{config::LineConfig::precise_timing_lead}
                                                : std::chrono::nanoseconds::zero();
     int floor_windows = 0;
+    double floor_silence_us = 0.0;  // the last floor window's median silence
     const auto floor_window = [&] {
         const bench::RawMasterResult floor = bench::run_raw_master(bench::RawMasterSetup{
             sim.path("line-floor"), shape, options.baud, turnaround, duration<double>(pair_seconds), floor_spin_lead});
+        floor_silence_us = floor.silence_median_us;
         if (++floor_windows == 1) {
             std::printf("the first floor window (minimal raw-syscall master on line-floor, %s, the daemon idle):\n",
                         label.c_str());
@@ -371,8 +373,22 @@ int run(const Options& options) {
                         "%.1f s windows: the floor on line-floor (no client running), then the clients on line-b ==\n",
                         clients, label.c_str(), pairs, pair_seconds);
             bench::FloorPairs floor_pairs;
+            std::vector<double> ceilings;  // one client: what its round trips leave (bench::closed_loop_ceiling)
             for (int pair = 1; pair <= pairs; ++pair) {
                 const bench::WindowFigures floor = floor_window();
+                if (clients == 1) {
+                    // The same single client against a server that answers at once: its
+                    // round trip is what the line waits on after each answer, minus the
+                    // silence, whatever the gateway does.
+                    bench::NullModbusServer null_server;
+                    const LoadFigures round_trip = run_load(null_server.port(), direct_target, 1, 1.0, [](bool) {});
+                    ceilings.push_back(bench::closed_loop_ceiling(floor.tps, round_trip.p50_us, floor_silence_us));
+                    std::printf("pair %d one client against a null server (1 s): round trip p50 %.0f us, p99 %.0f us; "
+                                "the floor's silence %.0f us: the line idles %.0f us per transaction, a ceiling of "
+                                "%.3f of the floor for any gateway\n",
+                                pair, round_trip.p50_us, round_trip.p99_us, floor_silence_us,
+                                std::max(0.0, round_trip.p50_us - floor_silence_us), ceilings.back());
+                }
                 const LineLoad load = line_b_load(clients, pair_seconds);
                 const auto& f = load.figures;
                 std::printf("pair %d daemon window: %llu reads answered in %.1f s = %.1f tx/s; errors %llu%s%s; "
@@ -395,6 +411,12 @@ int run(const Options& options) {
                         daemon_median.tps / limit.limit_tps, floor_pairs.median_rate_ratio(),
                         floor_median.tps / limit.limit_tps, daemon_median.cpu_us, floor_pairs.median_cpu_ratio(),
                         floor_median.cpu_us);
+            if (!ceilings.empty()) {
+                std::printf("summary: TCP->line %s, 1 client: one request outstanding caps it at %.3f of the floor "
+                            "(median of the pairs' closed-loop ceilings); the daemon reached %.3f of that ceiling\n",
+                            label.c_str(), bench::median_of(ceilings),
+                            floor_pairs.median_rate_ratio() / bench::median_of(ceilings));
+            }
         }
     }
 

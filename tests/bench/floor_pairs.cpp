@@ -22,6 +22,13 @@ double FloorPair::rate_ratio() const noexcept { return floor.tps > 0.0 ? gateway
 
 double FloorPair::cpu_ratio() const noexcept { return floor.cpu_us > 0.0 ? gateway.cpu_us / floor.cpu_us : 0.0; }
 
+double closed_loop_ceiling(double floor_tps, double round_trip_us, double silence_us) noexcept {
+    if (floor_tps <= 0.0) return 0.0;
+    const double period_us = 1e6 / floor_tps;
+    const double idle_us = round_trip_us > silence_us ? round_trip_us - silence_us : 0.0;
+    return period_us / (period_us + idle_us);
+}
+
 void FloorPairs::add(const char* bench, const char* gateway, const FloorPair& pair) {
     pairs_.push_back(pair);
     std::printf("%s pair %zu: floor %.1f tx/s, %.1f us/tx; %s %.1f tx/s, %.1f us/tx; ratios rate %.3f, CPU %.2fx\n",

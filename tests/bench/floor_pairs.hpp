@@ -26,6 +26,14 @@ struct FloorPair {
     [[nodiscard]] double cpu_ratio() const noexcept;
 };
 
+/// What one client, one request outstanding, can reach against the floor whatever the
+/// gateway does: after each answer the line waits for that client's next request, so
+/// it idles for whatever of the TCP round trip (answer sent -> client wakes -> next
+/// request received) the silence does not cover. With the floor's period P = 1 /
+/// @p floor_tps, a round trip of @p round_trip_us and the floor's silence of
+/// @p silence_us: P / (P + max(0, round trip - silence)). 0 when floor_tps is 0.
+[[nodiscard]] double closed_loop_ceiling(double floor_tps, double round_trip_us, double silence_us) noexcept;
+
 /// The pairs of one load, in the order they were measured.
 class FloorPairs {
 public:
