@@ -59,6 +59,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -412,10 +413,10 @@ int run(const Options& options) {
                         floor_median.tps / limit.limit_tps, daemon_median.cpu_us, floor_pairs.median_cpu_ratio(),
                         floor_median.cpu_us);
             if (!ceilings.empty()) {
+                const double ceiling = bench::median_of(std::move(ceilings));
                 std::printf("summary: TCP->line %s, 1 client: one request outstanding caps it at %.3f of the floor "
                             "(median of the pairs' closed-loop ceilings); the daemon reached %.3f of that ceiling\n",
-                            label.c_str(), bench::median_of(ceilings),
-                            floor_pairs.median_rate_ratio() / bench::median_of(ceilings));
+                            label.c_str(), ceiling, ratio(floor_pairs.median_rate_ratio(), ceiling));
             }
         }
     }
