@@ -3,12 +3,15 @@ client reads a line without pause, reloads that change only another line, or onl
 device's max_age / command_ttl, fail no request, reopen no port (the simulator counts the
 gateway's opens of each pty with inotify) and leave the line idle no longer than one
 transaction (the simulator measures the idle time between frames on the emulated wire). The line that did change restarts, and the count shows it.
+Each kind of reload runs three times and is judged by its median round, so that one stall
+of a shared machine does not pass for a cost of the reload.
 MQTT stays connected through reloads that leave its settings alone."""
 
 import json
 import os
 import re
 import signal
+import statistics
 import threading
 import time
 import unittest
@@ -26,6 +29,7 @@ TRANSACTION_S = 0.00308
 # than one transaction". The sanitizer build of ctest is several times slower at a
 # line restart and is held to looser bounds (below).
 RELEASE_BUILD = os.environ.get("FIELDBRIDGE_RELEASE_BUILD") == "1"
+ROUNDS = 3  # each kind of reload, done and undone in turn
 
 
 class Reader(threading.Thread):
@@ -75,8 +79,9 @@ class HitlessReload(gl.CellTestCase):
         return json.loads(self.control("silence line-b")[3:])
 
     def reload(self, expect):
-        """SIGHUP; returns (sent, done) once the log says `expect` and the reload is applied,
-        and the silence window of line-b that covers it."""
+        """SIGHUP; once the log says `expect` and the reload is applied, returns when it was
+        sent and seen applied, the silence window of line-b that covers it, and the wall
+        time and CPU time the apply held the loop (from its log line), in seconds."""
         self.silence_window()
         mark = len(self.gateway.text().splitlines())
         sent = time.monotonic()
@@ -90,11 +95,9 @@ class HitlessReload(gl.CellTestCase):
         print(applied[1][applied[1].find("; read and checked") + 2:])
         held = re.search(r"applied in ([0-9.]+) ms on the loop, ([0-9.]+) ms of CPU", applied[1])
         self.assertIsNotNone(held, applied[1])
-        self.loop_held.append(float(held.group(1)) / 1e3)
-        self.loop_cpu.append(float(held.group(2)) / 1e3)
         done = time.monotonic()
         self.more_reads(self.readers, 30)  # the line carried on after the reload
-        return sent, done, self.silence_window()
+        return sent, done, self.silence_window(), float(held.group(1)) / 1e3, float(held.group(2)) / 1e3
 
     def more_reads(self, readers, count):
         def total():
@@ -122,23 +125,30 @@ class HitlessReload(gl.CellTestCase):
         self.more_reads(self.readers, 600)
         base_silence = self.silence_window()
 
-        windows = []
-        self.loop_held = []  # seconds each reload's apply held the loop (from its log line)
-        self.loop_cpu = []  # seconds of CPU time the loop thread spent in each apply
-        # 1. Another line changes (line-a's response timeout): line-a restarts, line-b not.
-        self.rewrite("    response_timeout: 300ms\n    broadcast_unit: 100\n",
-                     "    response_timeout: 250ms\n    broadcast_unit: 100\n")
-        windows.append(self.reload("lines restarted: line-a"))
-        self.more_reads(self.readers, 100)
-        # 2. Another device of the read line changes its max_age: retuned in place.
-        self.rewrite("{name: gripper-3, type: wtec-rtu, address: 1, unit_id: 4, command_ttl: 2s}",
-                     "{name: gripper-3, type: wtec-rtu, address: 1, unit_id: 4, command_ttl: 2s, max_age: 1s}")
-        windows.append(self.reload("devices retuned: gripper-3"))
-        self.more_reads(self.readers, 100)
-        # 3. The device being read changes its own command_ttl and max_age (still 0).
-        self.rewrite("max_age: 0ms, command_ttl: 2s}", "max_age: 0s, command_ttl: 3s}")
-        windows.append(self.reload("devices retuned: gripper-4"))
-        self.more_reads(self.readers, 100)
+        # Each kind of reload runs ROUNDS times, its change made and then undone, and is
+        # judged by the median of its rounds: a cost the code adds shows in every round,
+        # while a stall of this shared machine (the baseline window above idles the line
+        # up to 11 ms without any reload) lands in one round, not in most of them.
+        kinds = [
+            # 1. Another line changes (line-a's response timeout): line-a restarts, line-b not.
+            ("lines restarted: line-a",
+             "    response_timeout: 300ms\n    broadcast_unit: 100\n",
+             "    response_timeout: 250ms\n    broadcast_unit: 100\n"),
+            # 2. Another device of the read line changes its max_age: retuned in place.
+            ("devices retuned: gripper-3",
+             "{name: gripper-3, type: wtec-rtu, address: 1, unit_id: 4, command_ttl: 2s}",
+             "{name: gripper-3, type: wtec-rtu, address: 1, unit_id: 4, command_ttl: 2s, max_age: 1s}"),
+            # 3. The device being read changes its own command_ttl (its max_age stays 0).
+            ("devices retuned: gripper-4", "max_age: 0ms, command_ttl: 2s}", "max_age: 0ms, command_ttl: 3s}"),
+        ]
+        # Per kind, one (sent, done, silence window, loop held s, loop CPU s) per round.
+        rounds = {expect: [] for expect, _, _ in kinds}
+        for round_number in range(ROUNDS):
+            for expect, before, after in kinds:
+                old, new = (before, after) if round_number % 2 == 0 else (after, before)
+                self.rewrite(old, new)
+                rounds[expect].append(self.reload(expect))
+                self.more_reads(self.readers, 30)
         for reader in self.readers:
             reader.stop.set()
         for reader in self.readers:
@@ -149,23 +159,25 @@ class HitlessReload(gl.CellTestCase):
         line_b = self.bus("line-b")
         self.assertEqual((line_b["port_opens"], line_b["port_closes"]), (1, 0),
                          "line-b's port was reopened: %s" % line_b)
-        self.assertEqual(self.bus("line-a")["port_opens"], 2, "line-a should have restarted once")
+        self.assertEqual(self.bus("line-a")["port_opens"], 1 + ROUNDS,
+                         "line-a should have restarted once a round")
         self.assertEqual(self.gateway.text().count("MQTT: broker"), connects, "MQTT reconnected")
         self.assertNotIn("MQTT: configuration changed", self.gateway.text())
 
         print("baseline: %d requests on line-b, longest idle %.0f us" % (base_silence["requests"],
                                                                        base_silence["max_silence_us"]))
         self.assertGreater(base_silence["requests"], 300)
-        for n, (sent, done, silence) in enumerate(windows, 1):
-            gaps = [gap for reader in self.readers for gap in reader.gaps(sent, done + 0.05)]
-            self.assertTrue(gaps, "no read completed during reload %d" % n)
-            print("reload %d: %d requests on line-b, longest idle %.0f us; longest client gap %.1f ms"
-                  % (n, silence["requests"], silence["max_silence_us"], max(gaps) * 1e3))
-            # The spec's aim is one transaction; this sanitizer build on a shared 2-core
-            # machine idles the line up to 6.7 ms without any reload, and a reload that
-            # restarts another line costs up to about two transactions more
-            # (docs/service.md, "Reload"). The bound catches a stall (a reopened or
-            # rebuilt line idles it for tens of milliseconds).
+        for n, (expect, _, _) in enumerate(kinds, 1):
+            for sent, done, silence, held, cpu in rounds[expect]:
+                gaps = [gap for reader in self.readers for gap in reader.gaps(sent, done + 0.05)]
+                self.assertTrue(gaps, "no read completed during a reload of kind %d (%s)" % (n, expect))
+                print("reload %d (%s): %d requests on line-b, longest idle %.0f us; longest client gap "
+                      "%.1f ms; loop held %.2f ms, %.2f ms of CPU"
+                      % (n, expect, silence["requests"], silence["max_silence_us"], max(gaps) * 1e3,
+                         held * 1e3, cpu * 1e3))
+            idle_us = statistics.median(r[2]["max_silence_us"] for r in rounds[expect])
+            median_held = statistics.median(r[3] for r in rounds[expect])
+            median_cpu = statistics.median(r[4] for r in rounds[expect])
             # The loop drives every line: what a reload's apply holds it for is the most it
             # can add to a line's idle time. A retune costs well under a transaction; a
             # reload that restarts another line (close, build, open) about one in this
@@ -175,15 +187,18 @@ class HitlessReload(gl.CellTestCase):
             # restart whose components took 4.9 ms hold the loop 8.8 ms). So the CPU time
             # is held to the aim and the wall time to a stall bound.
             limit = TRANSACTION_S if n > 1 or RELEASE_BUILD else 2 * TRANSACTION_S
-            self.assertLessEqual(self.loop_cpu[n - 1], limit,
-                                 "reload %d cost the loop %.2f ms of CPU" % (n, self.loop_cpu[n - 1] * 1e3))
+            self.assertLessEqual(median_cpu, limit, "reload %d: the median round cost the loop %.2f ms "
+                                 "of CPU" % (n, median_cpu * 1e3))
             stall = (2 if RELEASE_BUILD else 5) * TRANSACTION_S
-            self.assertLessEqual(self.loop_held[n - 1], stall,
-                                 "reload %d held the loop %.2f ms" % (n, self.loop_held[n - 1] * 1e3))
-            self.assertLessEqual(silence["max_silence_us"],
-                                 base_silence["max_silence_us"]
+            self.assertLessEqual(median_held, stall, "reload %d: the median round held the loop %.2f ms"
+                                 % (n, median_held * 1e3))
+            # The line's own idle time, measured on the wire, against the same run's
+            # baseline: the spec's aim of one transaction in Release; this sanitizer build
+            # is held to three (a reopened or rebuilt line idles it for tens of ms).
+            self.assertLessEqual(idle_us, base_silence["max_silence_us"]
                                  + (1 if RELEASE_BUILD else 3) * TRANSACTION_S * 1e6,
-                                 "reload %d left line-b idle much longer than without a reload" % n)
+                                 "reload %d: in the median round line-b idled %.0f us, much longer than "
+                                 "without a reload" % (n, idle_us))
 
 if __name__ == "__main__":
     gl.main()
