@@ -7,12 +7,8 @@
 //
 // The server runs on its own thread (the daemon's loop); the load generator on
 // another, with poll() over non-blocking sockets. Not a test: it asserts nothing.
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <asio/executor_work_guard.hpp>
@@ -27,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "loopback_port.hpp"
 #include "northbound/modbus_tcp/server.hpp"
 #include "protocol/mbap_frame.hpp"
 #include "protocol/modbus_pdu.hpp"
@@ -53,27 +50,12 @@ private:
 };
 
 struct BenchClient {
-    int fd = -1;
+    test_support::UniqueFd fd;
     protocol::Bytes request;
     protocol::Bytes rx;
     std::size_t expected = 0;
     Clock::time_point sent;
 };
-
-[[nodiscard]] int connect_loopback(std::uint16_t port) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    if (fd < 0) throw std::runtime_error("socket() failed");
-    const int one = 1;
-    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_port = htons(port);
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-        throw std::runtime_error("connect failed");
-    }
-    return fd;
-}
 
 }  // namespace
 
@@ -99,18 +81,18 @@ int main(int argc, char** argv) {
     std::vector<pollfd> fds(clients);
     const std::size_t response_size = protocol::mbap_header_size + 2 + 2U * registers;
     for (std::size_t i = 0; i < clients; ++i) {
-        pool[i].fd = connect_loopback(port);
+        pool[i].fd = bench::connect_loopback(port);
         pool[i].request = protocol::encode_mbap(
             static_cast<std::uint16_t>(i), core::UnitId{1},
             protocol::encode_request(protocol::ReadRegistersRequest{0x03, 0x0300, registers}));
         pool[i].expected = response_size;
-        fds[i] = pollfd{pool[i].fd, POLLIN, 0};
+        fds[i] = pollfd{pool[i].fd.get(), POLLIN, 0};
     }
     std::vector<double> latencies_us;
     latencies_us.reserve(static_cast<std::size_t>(seconds * 200000));
     const auto send = [](BenchClient& c) {
         c.sent = Clock::now();
-        if (::send(c.fd, c.request.data(), c.request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(c.request.size())) {
+        if (::send(c.fd.get(), c.request.data(), c.request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(c.request.size())) {
             throw std::runtime_error("send failed");
         }
     };
@@ -123,7 +105,7 @@ int main(int argc, char** argv) {
         for (std::size_t i = 0; i < clients; ++i) {
             if ((fds[i].revents & POLLIN) == 0) continue;
             BenchClient& c = pool[i];
-            const auto n = ::recv(c.fd, buffer, sizeof buffer, MSG_DONTWAIT);
+            const auto n = ::recv(c.fd.get(), buffer, sizeof buffer, MSG_DONTWAIT);
             if (n <= 0) throw std::runtime_error("connection lost");
             c.rx.insert(c.rx.end(), buffer, buffer + n);
             while (c.rx.size() >= c.expected) {
@@ -134,7 +116,6 @@ int main(int argc, char** argv) {
         }
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    for (auto& c : pool) ::close(c.fd);
     asio::post(io, [&] { server.stop(); });
     work.reset();
     loop.join();

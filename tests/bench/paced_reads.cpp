@@ -1,11 +1,9 @@
 #include "paced_reads.hpp"
 
+#include "loopback_port.hpp"
 #include "percentile.hpp"
 #include "unique_fd.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <sys/epoll.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
@@ -15,7 +13,6 @@
 #include <array>
 #include <cerrno>
 #include <cstring>
-#include <stdexcept>
 #include <vector>
 
 namespace fieldbridge::bench {
@@ -25,22 +22,6 @@ using Clock = std::chrono::steady_clock;
 
 /// Owns a file descriptor.
 using Fd = test_support::UniqueFd;
-
-Fd connect_loopback(std::uint16_t port) {
-    Fd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
-    if (fd.get() < 0) throw std::runtime_error(std::string("paced reads: socket: ") + std::strerror(errno));
-    const int one = 1;
-    ::setsockopt(fd.get(), IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_port = htons(port);
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd.get(), reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
-        throw std::runtime_error("paced reads: cannot connect to 127.0.0.1:" + std::to_string(port) + ": " +
-                                 std::strerror(errno));
-    }
-    return fd;
-}
 
 struct Connection {
     Fd fd;

@@ -1,20 +1,18 @@
 #include "tcp_load.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <mutex>
 #include <random>
 #include <span>
+#include <stdexcept>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "loopback_port.hpp"
 #include "percentile.hpp"
 
 namespace fieldbridge::bench {
@@ -35,23 +33,19 @@ bool read_exactly(int fd, std::uint8_t* data, std::size_t size) {
     return true;
 }
 
-/// A blocking loopback Modbus TCP connection (TCP_NODELAY, 3 s receive timeout so a
-/// lost answer ends the client, not the run); -1 when it cannot connect.
-int connect_client(std::uint16_t port) {
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    const int one = 1;
-    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    const timeval timeout{3, 0};
-    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_port = htons(port);
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
-        close(fd);
-        return -1;
+/// A client connection for the load (loopback_port.hpp) with a 3 s receive timeout, so
+/// that a lost answer ends the client, not the run; an empty one, with @p failure saying
+/// why, when it cannot connect.
+test_support::UniqueFd connect_client(std::uint16_t port, std::string& failure) {
+    try {
+        test_support::UniqueFd fd = connect_loopback(port);
+        const timeval timeout{3, 0};
+        setsockopt(fd.get(), SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+        return fd;
+    } catch (const std::runtime_error& error) {
+        failure = error.what();
+        return test_support::UniqueFd{};
     }
-    return fd;
 }
 
 /// Sends @p request (a whole MBAP frame) and reads the answer's MBAP header and PDU
@@ -81,11 +75,8 @@ void run_client(std::uint16_t port, Target target, std::uint64_t first, const st
                 Clock::time_point window_start, Clock::time_point window_end, ClientResult& result) {
     // Linux: a thread's nice value is its own (setpriority on the thread id).
     static_cast<void>(setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10));
-    const int fd = connect_client(port);
-    if (fd < 0) {
-        result.failure = "connect failed";
-        return;
-    }
+    const test_support::UniqueFd fd = connect_client(port, result.failure);
+    if (fd.get() < 0) return;
     result.latency_us.reserve(400'000);
     std::uint16_t transaction = 0;
     for (std::uint64_t n = first; !stop.load(std::memory_order_relaxed); ++n) {
@@ -98,7 +89,7 @@ void run_client(std::uint16_t port, Target target, std::uint64_t first, const st
             static_cast<std::uint8_t>(read.count >> 8), static_cast<std::uint8_t>(read.count & 0xFF)};
         const Clock::time_point sent = Clock::now();
         std::array<std::uint8_t, 260> reply{};
-        const std::size_t rest = exchange(fd, request, reply, result.failure);
+        const std::size_t rest = exchange(fd.get(), request, reply, result.failure);
         if (rest == 0) break;
         const auto answered = Clock::now();
         const bool ok = reply[7] == read.function && rest == std::size_t{2} + 2u * read.count;
@@ -108,16 +99,12 @@ void run_client(std::uint16_t port, Target target, std::uint64_t first, const st
             result.latency_us.push_back(duration<double, std::micro>(answered - sent).count());
         }
     }
-    close(fd);
 }
 
 ClientResult run_writer(std::uint16_t port, std::uint8_t unit, std::uint16_t address, int count) {
     ClientResult result;
-    const int fd = connect_client(port);
-    if (fd < 0) {
-        result.failure = "connect failed";
-        return result;
-    }
+    const test_support::UniqueFd fd = connect_client(port, result.failure);
+    if (fd.get() < 0) return result;
     std::mt19937 random(20261125);
     std::uniform_int_distribution<int> gap_us(30'000, 50'000);
     for (int i = 0; i < count; ++i) {
@@ -130,7 +117,7 @@ ClientResult run_writer(std::uint16_t port, std::uint8_t unit, std::uint16_t add
             static_cast<std::uint8_t>(value >> 8), static_cast<std::uint8_t>(value & 0xFF)};
         const auto sent = Clock::now();
         std::array<std::uint8_t, 260> reply{};
-        const std::size_t rest = exchange(fd, request, reply, result.failure);
+        const std::size_t rest = exchange(fd.get(), request, reply, result.failure);
         if (rest == 0) break;
         const auto answered = Clock::now();
         // FC06 answers with the request's PDU echoed.
@@ -141,11 +128,8 @@ ClientResult run_writer(std::uint16_t port, std::uint8_t unit, std::uint16_t add
             if (reply[7] == 0x86 && rest == 2) ++result.exceptions[reply[8]];
         }
     }
-    close(fd);
     return result;
 }
-
-
 
 LoadFigures run_load(std::uint16_t port, Target target, unsigned clients, double seconds,
                      const std::function<void(bool)>& in_window) {
