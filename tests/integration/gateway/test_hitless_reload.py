@@ -7,6 +7,7 @@ Each kind of reload runs three times and is judged by its median round, so that 
 of a shared machine does not pass for a cost of the reload.
 MQTT stays connected through reloads that leave its settings alone."""
 
+import collections
 import json
 import os
 import re
@@ -30,6 +31,9 @@ TRANSACTION_S = 0.00308
 # line restart and is held to looser bounds (below).
 RELEASE_BUILD = os.environ.get("FIELDBRIDGE_RELEASE_BUILD") == "1"
 ROUNDS = 3  # each kind of reload, done and undone in turn
+# One reload: when SIGHUP was sent and the apply seen, line-b's silence window around it,
+# and the wall time and CPU time the apply held the loop (from its log line), in seconds.
+Round = collections.namedtuple("Round", "sent done silence held_s cpu_s")
 
 
 class Reader(threading.Thread):
@@ -79,9 +83,7 @@ class HitlessReload(gl.CellTestCase):
         return json.loads(self.control("silence line-b")[3:])
 
     def reload(self, expect):
-        """SIGHUP; once the log says `expect` and the reload is applied, returns when it was
-        sent and seen applied, the silence window of line-b that covers it, and the wall
-        time and CPU time the apply held the loop (from its log line), in seconds."""
+        """SIGHUP; once the log says `expect` and the reload is applied, its Round."""
         self.silence_window()
         mark = len(self.gateway.text().splitlines())
         sent = time.monotonic()
@@ -97,7 +99,7 @@ class HitlessReload(gl.CellTestCase):
         self.assertIsNotNone(held, applied[1])
         done = time.monotonic()
         self.more_reads(self.readers, 30)  # the line carried on after the reload
-        return sent, done, self.silence_window(), float(held.group(1)) / 1e3, float(held.group(2)) / 1e3
+        return Round(sent, done, self.silence_window(), float(held.group(1)) / 1e3, float(held.group(2)) / 1e3)
 
     def more_reads(self, readers, count):
         def total():
@@ -141,7 +143,7 @@ class HitlessReload(gl.CellTestCase):
             # 3. The device being read changes its own command_ttl (its max_age stays 0).
             ("devices retuned: gripper-4", "max_age: 0ms, command_ttl: 2s}", "max_age: 0ms, command_ttl: 3s}"),
         ]
-        # Per kind, one (sent, done, silence window, loop held s, loop CPU s) per round.
+        # Per kind, its Rounds.
         rounds = {expect: [] for expect, _, _ in kinds}
         for round_number in range(ROUNDS):
             for expect, before, after in kinds:
@@ -168,16 +170,16 @@ class HitlessReload(gl.CellTestCase):
                                                                        base_silence["max_silence_us"]))
         self.assertGreater(base_silence["requests"], 300)
         for n, (expect, _, _) in enumerate(kinds, 1):
-            for sent, done, silence, held, cpu in rounds[expect]:
-                gaps = [gap for reader in self.readers for gap in reader.gaps(sent, done + 0.05)]
+            for one in rounds[expect]:
+                gaps = [gap for reader in self.readers for gap in reader.gaps(one.sent, one.done + 0.05)]
                 self.assertTrue(gaps, "no read completed during a reload of kind %d (%s)" % (n, expect))
                 print("reload %d (%s): %d requests on line-b, longest idle %.0f us; longest client gap "
                       "%.1f ms; loop held %.2f ms, %.2f ms of CPU"
-                      % (n, expect, silence["requests"], silence["max_silence_us"], max(gaps) * 1e3,
-                         held * 1e3, cpu * 1e3))
-            idle_us = statistics.median(r[2]["max_silence_us"] for r in rounds[expect])
-            median_held = statistics.median(r[3] for r in rounds[expect])
-            median_cpu = statistics.median(r[4] for r in rounds[expect])
+                      % (n, expect, one.silence["requests"], one.silence["max_silence_us"], max(gaps) * 1e3,
+                         one.held_s * 1e3, one.cpu_s * 1e3))
+            idle_us = statistics.median(one.silence["max_silence_us"] for one in rounds[expect])
+            median_held = statistics.median(one.held_s for one in rounds[expect])
+            median_cpu = statistics.median(one.cpu_s for one in rounds[expect])
             # The loop drives every line: what a reload's apply holds it for is the most it
             # can add to a line's idle time. A retune costs well under a transaction; a
             # reload that restarts another line (close, build, open) about one in this
