@@ -30,16 +30,35 @@ void BroadcastBudget::refill(engine::TimePoint now) noexcept {
     last_ = now;
 }
 
+void BroadcastBudget::spend(engine::Duration cost) noexcept {
+    balance_ = std::max(-capacity_, balance_ - cost);
+}
+
 bool BroadcastBudget::take(engine::Duration cost, engine::TimePoint now) noexcept {
     refill(now);
     if (balance_ <= engine::Duration::zero()) return false;
-    balance_ -= cost;
+    spend(cost);
     return true;
 }
 
 void BroadcastBudget::charge(engine::Duration cost, engine::TimePoint now) noexcept {
     refill(now);
-    balance_ -= cost;
+    spend(cost);
+}
+
+void BroadcastBudget::refund(engine::Duration cost, engine::TimePoint now) noexcept {
+    refill(now);
+    balance_ = std::min(capacity_, balance_ + cost);
+}
+
+engine::TimePoint BroadcastBudget::available_at(engine::TimePoint now) noexcept {
+    refill(now);
+    if (balance_ > engine::Duration::zero()) return now;
+    // The balance grows by share_of(time passed), rounded down: positive once
+    // elapsed x share / 100 >= debt + 1 tick.
+    const engine::Duration::rep debt = (-balance_).count();
+    const auto share = static_cast<engine::Duration::rep>(share_percent_);
+    return now + engine::Duration{((debt + 1) * 100 + share - 1) / share};
 }
 
 }  // namespace fieldbridge::northbound

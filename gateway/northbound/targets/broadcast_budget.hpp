@@ -7,11 +7,16 @@
 /// time).
 ///
 /// A token bucket of line time: it fills at `share` of the time that passes, up to
-/// `share` of one second, and starts full. A broadcast may start while the bucket is
-/// not empty and takes its cost out (the balance may go below zero, so one broadcast
-/// longer than the bucket still goes out, and the next waits until it is paid for).
-/// Over any span the broadcasts of the line take at most `share` of it plus one
-/// second's worth.
+/// `share` of one second (the capacity), and starts full. A broadcast may start while
+/// the bucket is not empty and takes its cost out; the balance may go below zero (one
+/// broadcast longer than the bucket still goes out, and the next waits until it is
+/// paid for), but never below minus the capacity, so however long a flood lasts the
+/// bucket is positive again at most two seconds after it ends. Over any span the
+/// broadcasts of the line take at most `share` of it plus two seconds' worth.
+///
+/// What is taken is a reservation: a broadcast that does not go on the line after all
+/// (refused by the line's queue, expired, line down) gives its cost back (refund()),
+/// so only what went on the line is charged.
 #include <cstdint>
 
 #include "engine/transaction.hpp"
@@ -27,13 +32,18 @@ public:
     /// start at @p now; false: over budget, nothing taken.
     [[nodiscard]] bool take(engine::Duration cost, engine::TimePoint now) noexcept;
 
-    /// Takes the cost of a broadcast that goes out whatever the balance (a stop or
-    /// e-stop, rule 4: a fairness budget never holds back a stop). The balance may go
-    /// below zero: the broadcasts after it wait until the stop is paid for.
+    /// Takes @p cost whatever the balance (down to the floor, minus the capacity).
     void charge(engine::Duration cost, engine::TimePoint now) noexcept;
+
+    /// Gives back @p cost taken for a broadcast that did not go on the line.
+    void refund(engine::Duration cost, engine::TimePoint now) noexcept;
+
+    /// The first time at or after @p now at which take() can succeed.
+    [[nodiscard]] engine::TimePoint available_at(engine::TimePoint now) noexcept;
 
 private:
     void refill(engine::TimePoint now) noexcept;
+    void spend(engine::Duration cost) noexcept;
 
     unsigned share_percent_;
     engine::Duration capacity_;

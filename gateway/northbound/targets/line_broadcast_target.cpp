@@ -1,6 +1,8 @@
 #include "northbound/targets/line_broadcast_target.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <numeric>
 
 #include <asio/post.hpp>
 
@@ -48,30 +50,50 @@ struct LineBroadcastTarget::Shared {
     engine::LineWorker* line;
     engine::Duration command_ttl;
     std::vector<engine::DeviceAgent*> agents;  ///< cleared with `line` when the target goes
+    BroadcastBudget budget;                    ///< every broadcast of the line
+    BroadcastBudget stop_budget;               ///< stops only (rule 4): they never wait for the other
+    std::vector<std::shared_ptr<Operation>> held_stops;  ///< over the stops' budget, oldest first
+    asio::steady_timer stop_timer;
+    bool stop_timer_armed = false;
+
+    Shared(asio::io_context& context, engine::LineWorker& worker, const BroadcastSettings& settings)
+        : io(context),
+          line(&worker),
+          command_ttl(settings.command_ttl),
+          budget(settings.share_percent),
+          stop_budget(settings.share_percent),
+          stop_timer(context) {}
 };
 
 /// One broadcast on its way: its steps, the next one, and who to answer.
 struct LineBroadcastTarget::Operation {
     protocol::Request request;
+    protocol::Bytes request_pdu;  ///< as the client sent it: identical stops are one frame
     std::vector<BroadcastStep> steps;
+    std::vector<engine::Duration> step_costs;  ///< line time of each step, charged to the budget
     std::size_t next = 0;
+    bool stop = false;
     core::FunctionCode function;
     protocol::Bytes echo;
-    PduHandler done;
+    std::vector<PduHandler> waiting;  ///< the client, and the clients of identical stops held with it
 
-    void answer(asio::io_context& io, protocol::Bytes pdu) {
-        if (!done) return;
+    void answer(asio::io_context& io, const protocol::Bytes& pdu) {
         // Never from inside handle() or the line's completion (unit_target.hpp).
-        asio::post(io, [done = std::move(done), pdu = std::move(pdu)]() mutable { done(std::move(pdu)); });
-        done = nullptr;
+        for (PduHandler& done : waiting) {
+            asio::post(io, [done = std::move(done), pdu]() mutable { done(pdu); });
+        }
+        waiting.clear();
+    }
+    /// The cost of the steps not sent yet.
+    [[nodiscard]] engine::Duration unsent_cost() const {
+        return std::accumulate(step_costs.begin() + static_cast<std::ptrdiff_t>(next), step_costs.end(),
+                               engine::Duration{});
     }
 };
 
 LineBroadcastTarget::LineBroadcastTarget(asio::io_context& io, engine::LineWorker& line, std::vector<LineUnit> devices,
                                          BroadcastSettings settings)
-    : shared_(std::make_shared<Shared>(Shared{io, &line, settings.command_ttl, {}})),
-      devices_(std::move(devices)),
-      budget_(settings.share_percent) {
+    : shared_(std::make_shared<Shared>(io, line, settings)), devices_(std::move(devices)) {
     for (const LineUnit& device : devices_) {
         units_.push_back(device.unit_id);
         shared_->agents.push_back(device.agent);
@@ -81,18 +103,24 @@ LineBroadcastTarget::LineBroadcastTarget(asio::io_context& io, engine::LineWorke
 LineBroadcastTarget::~LineBroadcastTarget() {
     shared_->line = nullptr;
     shared_->agents.clear();
+    shared_->stop_timer.cancel();
+    for (const std::shared_ptr<Operation>& op : shared_->held_stops) {
+        op->answer(shared_->io, protocol::exception_pdu(op->function, GatewayRefusal::path_down));
+    }
+    shared_->held_stops.clear();
 }
 
-engine::Duration LineBroadcastTarget::line_time(const std::vector<BroadcastStep>& steps) const {
+std::vector<engine::Duration> LineBroadcastTarget::line_time(const std::vector<BroadcastStep>& steps) const {
     const engine::LineTimingConfig& timing = shared_->line->config().timing;
     const engine::LineTiming wire(timing.format(), timing.inter_frame);
-    engine::Duration total{};
+    std::vector<engine::Duration> costs;
+    costs.reserve(steps.size());
     for (const BroadcastStep& step : steps) {
         const std::size_t frame =
             protocol::encode_request(std::get<engine::ModbusPayload>(step.payload).request).size() + rtu_overhead;
-        total += step.delay_before + wire.transaction_time(frame, 0, timing.broadcast_delay);
+        costs.push_back(step.delay_before + wire.transaction_time(frame, 0, timing.broadcast_delay));
     }
-    return total;
+    return costs;
 }
 
 void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
@@ -100,8 +128,8 @@ void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView reque
     asio::io_context& io = shared_->io;
     auto op = std::make_shared<Operation>();
     op->function = protocol::pdu_function(request_pdu);
-    op->done = std::move(done);
-    const auto refuse = [&](protocol::Bytes pdu) { op->answer(io, std::move(pdu)); };
+    op->waiting.push_back(std::move(done));
+    const auto refuse = [&](const protocol::Bytes& pdu) { op->answer(io, pdu); };
     const auto decoded = protocol::decode_request(request_pdu);
     if (!decoded.complete()) {
         refuse(protocol::exception_pdu(op->function, protocol::refusal_for_undecodable(op->function)));
@@ -127,18 +155,62 @@ void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView reque
         refuse(protocol::exception_pdu(op->function, *plan.refusal));
         return;
     }
-    const bool stop = std::all_of(plan.steps.begin(), plan.steps.end(),
-                                  [](const BroadcastStep& step) { return step.urgent; });
-    if (stop) {
-        budget_.charge(line_time(plan.steps), engine::Clock::now());
-    } else if (!budget_.take(line_time(plan.steps), engine::Clock::now())) {
+    op->stop = std::all_of(plan.steps.begin(), plan.steps.end(), [](const BroadcastStep& step) { return step.urgent; });
+    op->step_costs = line_time(plan.steps);
+    op->request = decoded.value;
+    op->request_pdu.assign(request_pdu.begin(), request_pdu.end());
+    op->steps = std::move(plan.steps);
+    op->echo = protocol::encode_response(*echo);
+    if (op->stop) {
+        send_stop(shared_, op);
+        return;
+    }
+    if (!shared_->budget.take(op->unsent_cost(), engine::Clock::now())) {
         refuse(protocol::exception_pdu(op->function, GatewayRefusal::busy));
         return;
     }
-    op->request = decoded.value;
-    op->steps = std::move(plan.steps);
-    op->echo = protocol::encode_response(*echo);
     submit_step(shared_, op);
+}
+
+void LineBroadcastTarget::send_stop(const std::shared_ptr<Shared>& shared, const std::shared_ptr<Operation>& op) {
+    for (const std::shared_ptr<Operation>& held : shared->held_stops) {
+        if (held->request_pdu == op->request_pdu) {
+            // The same frame is already waiting: it answers this client too.
+            std::move(op->waiting.begin(), op->waiting.end(), std::back_inserter(held->waiting));
+            return;
+        }
+    }
+    const engine::TimePoint now = engine::Clock::now();
+    if (shared->held_stops.empty() && shared->stop_budget.take(op->unsent_cost(), now)) {
+        shared->budget.charge(op->unsent_cost(), now);
+        submit_step(shared, op);
+        return;
+    }
+    shared->held_stops.push_back(op);
+    arm_stop_timer(shared);
+}
+
+void LineBroadcastTarget::release_held_stops(const std::shared_ptr<Shared>& shared) {
+    const engine::TimePoint now = engine::Clock::now();
+    while (!shared->held_stops.empty() && shared->stop_budget.take(shared->held_stops.front()->unsent_cost(), now)) {
+        std::shared_ptr<Operation> op = std::move(shared->held_stops.front());
+        shared->held_stops.erase(shared->held_stops.begin());
+        shared->budget.charge(op->unsent_cost(), now);
+        submit_step(shared, op);
+    }
+    if (!shared->held_stops.empty()) arm_stop_timer(shared);
+}
+
+void LineBroadcastTarget::arm_stop_timer(const std::shared_ptr<Shared>& shared) {
+    if (shared->stop_timer_armed) return;
+    shared->stop_timer_armed = true;
+    shared->stop_timer.expires_at(shared->stop_budget.available_at(engine::Clock::now()));
+    shared->stop_timer.async_wait([weak = std::weak_ptr<Shared>(shared)](const std::error_code& error) {
+        const std::shared_ptr<Shared> alive = weak.lock();
+        if (error || !alive || alive->line == nullptr) return;
+        alive->stop_timer_armed = false;
+        release_held_stops(alive);
+    });
 }
 
 void LineBroadcastTarget::submit_step(const std::shared_ptr<Shared>& shared, const std::shared_ptr<Operation>& op) {
@@ -157,12 +229,16 @@ void LineBroadcastTarget::submit_step(const std::shared_ptr<Shared>& shared, con
     transaction.deadline = engine::Clock::now() + shared->command_ttl;  // rule 9
     transaction.on_done = [shared, op](const engine::Outcome& outcome) {
         if (outcome.status != engine::OutcomeStatus::broadcast_sent) {
+            // Not on the line: what it reserved is given back (only what was sent is charged).
+            const engine::TimePoint now = engine::Clock::now();
+            shared->budget.refund(op->unsent_cost(), now);
+            if (op->stop) shared->stop_budget.refund(op->unsent_cost(), now);
             op->answer(shared->io, protocol::exception_pdu(op->function, engine::refusal_for(outcome.status)));
             return;
         }
         if (++op->next == op->steps.size()) {
             for (engine::DeviceAgent* agent : shared->agents) agent->broadcast_written(op->request);
-            op->answer(shared->io, std::move(op->echo));
+            op->answer(shared->io, op->echo);
             return;
         }
         submit_step(shared, op);

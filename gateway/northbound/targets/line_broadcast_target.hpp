@@ -12,7 +12,15 @@
 ///  - The bus address is 0 for Modbus devices and 0xFF for the EXCD203MB (seed 002
 ///    §5); a line with both gets the write once per address whose devices take it.
 ///  - The line's broadcast budget (`broadcast_share`, broadcast_budget.hpp): a
-///    broadcast that would exceed it is refused with 0x06 before it is queued.
+///    broadcast that would exceed it is refused with 0x06 before it is queued. Only
+///    what went on the line is charged: a broadcast that is not sent after all gives
+///    its share back.
+///  - A stop (every step urgent, rule 4) is never refused and goes ahead of every
+///    queued command, but stops have a budget of their own at the same share: a stop
+///    over it is held (not refused) until the stops' budget allows it, and a held stop
+///    identical to one already held rides with it (one frame, every client answered
+///    when it was written). So the first stop goes out at once whatever ordinary
+///    broadcasts spent, and a flood of stops takes at most the share of the line.
 ///  - The writes go in the command class with the line's shortest `command_ttl`, one
 ///    after another. The client is answered after the last one has been written and
 ///    the line has settled (nobody answers a broadcast, so "written" is all there is
@@ -20,6 +28,7 @@
 ///    sequence with the exception of its outcome (0x06, 0x0B, 0x0A:
 ///    protocol/gateway_exceptions.hpp). No acknowledgement for a write not sent.
 #include <asio/io_context.hpp>
+#include <asio/steady_timer.hpp>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -63,12 +72,15 @@ private:
     struct Shared;
     struct Operation;
     static void submit_step(const std::shared_ptr<Shared>& shared, const std::shared_ptr<Operation>& op);
-    [[nodiscard]] engine::Duration line_time(const std::vector<BroadcastStep>& steps) const;
+    static void send_stop(const std::shared_ptr<Shared>& shared, const std::shared_ptr<Operation>& op);
+    static void release_held_stops(const std::shared_ptr<Shared>& shared);
+    static void arm_stop_timer(const std::shared_ptr<Shared>& shared);
+    /// The line time each step holds (frame, silence, delay before, broadcast_delay).
+    [[nodiscard]] std::vector<engine::Duration> line_time(const std::vector<BroadcastStep>& steps) const;
 
     std::shared_ptr<Shared> shared_;
     std::vector<LineUnit> devices_;
     std::vector<core::UnitId> units_;
-    BroadcastBudget budget_;
 };
 
 }  // namespace fieldbridge::northbound

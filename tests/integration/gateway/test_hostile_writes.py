@@ -186,6 +186,94 @@ class HostileWrites(Cell):
         self.assertGreater(results["ok"], 0)
         self.assertEqual(self.line_broadcasts("line-a") - before, results["ok"])
 
+    def test_a_flood_of_stops_leaves_the_neighbours_their_line_and_the_budget_recovers(self):
+        # 4 connections x 16 pipelined EXCD203MB stops (0x0108 = 0, rule 4) to the
+        # broadcast unit: every stop is answered, the XEG beside it keeps at least half
+        # of its line transactions and every read of it succeeds, identical stops held
+        # together go out as one frame, and an ordinary broadcast is accepted again
+        # within seconds of the flood's end (the budget's debt has a floor).
+        self.start_cell()
+        client = self.client()
+        self.assertTrue(simlib.wait_until(lambda: not client.read_input_registers(0x0300, 2, slave=XEG).isError(),
+                                          TIMEOUT, interval=0.05))
+
+        def xeg_rate(seconds):
+            failed = []
+            frames = self.device_frames("line-a", 2)
+            end = time.monotonic() + seconds
+            while time.monotonic() < end:
+                reply = client.read_input_registers(0x0300, 2, slave=XEG)
+                if reply.isError():
+                    failed.append(getattr(reply, "exception_code", reply))
+                time.sleep(0.01)
+            return failed, self.device_frames("line-a", 2) - frames
+
+        failed, baseline_frames = xeg_rate(3.0)
+        self.assertEqual(failed, [])
+        before = self.line_broadcasts("line-a")
+        stop = threading.Event()
+        results = {"ok": 0, "other": {}, "lost": 0}
+        lock = threading.Lock()
+        stop_pdu = write_single(0x0108, 0)
+
+        def flood():
+            sock = self.raw()
+            transaction = 0
+            while not stop.is_set():
+                sock.sendall(b"".join(mbap((transaction + i) & 0xFFFF, BROADCAST, stop_pdu) for i in range(16)))
+                for _ in range(16):
+                    frame = read_frame(sock)
+                    with lock:
+                        if frame is None:
+                            results["lost"] += 1
+                        elif frame[2] == stop_pdu:
+                            results["ok"] += 1
+                        else:
+                            code = frame[2].hex(" ")
+                            results["other"][code] = results["other"].get(code, 0) + 1
+                transaction += 16
+
+        flooders = [threading.Thread(target=flood, daemon=True) for _ in range(4)]
+        for flooder in flooders:
+            flooder.start()
+        started = time.monotonic()
+        try:
+            failed, during_frames = xeg_rate(6.0)
+        finally:
+            stop.set()
+            for flooder in flooders:
+                flooder.join(TIMEOUT)
+        flood_seconds = time.monotonic() - started
+        ended = time.monotonic()
+        broadcasts = self.line_broadcasts("line-a") - before
+        print("XEG: %d line transactions in 3 s alone, %d in 6 s of stops (%.0f %% of the rate); stops %r; "
+              "%d stop frames on the line in %.1f s" % (baseline_frames, during_frames,
+                                                        100.0 * during_frames / 2 / max(baseline_frames, 1),
+                                                        results, broadcasts, flood_seconds))
+        self.assertEqual(failed, [], "reads of the XEG failed during the flood of stops")
+        self.assertGreaterEqual(during_frames / 6.0, 0.5 * baseline_frames / 3.0,
+                                "the XEG's line rate during the flood of stops")
+        self.assertEqual(results["lost"], 0)
+        self.assertEqual(results["other"], {}, "a stop was refused or not sent")
+        self.assertGreater(broadcasts, 0)
+        # One stop frame holds the line ~101 ms (frame, t3.5, broadcast_delay 100 ms);
+        # the stops' share is 10 %: about one a second, plus the bucket's first second.
+        self.assertLess(broadcasts, flood_seconds * 0.1 / 0.1 + 3, "stops beyond the line's broadcast share")
+        self.assertGreater(results["ok"], broadcasts, "identical held stops were not sent as one frame")
+        # An ordinary broadcast is accepted again within seconds.
+        sock = self.raw()
+        transaction = 0
+
+        def accepted():
+            nonlocal transaction
+            transaction += 1
+            return self.exchange(sock, BROADCAST, write_single(0x0630, 1000 + transaction),
+                                 transaction) == write_single(0x0630, 1000 + transaction)
+
+        self.assertTrue(simlib.wait_until(accepted, 5.0, interval=0.1), "no ordinary broadcast accepted after the flood")
+        print("an ordinary broadcast was accepted %.1f s after the flood" % (time.monotonic() - ended))
+        self.assertLess(time.monotonic() - ended, 3.0)
+
     def test_a_cached_read_after_a_broadcast_shows_what_it_wrote(self):
         # EXCD203MB 0x0026 (curdwn) is in the slow poll (1 s): its cached value stayed
         # the old one after a broadcast changed it on the drive, until the next poll.

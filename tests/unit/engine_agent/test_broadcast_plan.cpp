@@ -98,3 +98,40 @@ TEST_CASE("broadcast budget: a stop goes out over budget and the broadcasts afte
     CHECK_FALSE(budget.take(1ms, t0 + 900ms));  // refilled 90 ms: -10 ms
     CHECK(budget.take(1ms, t0 + 1100ms));       // +10 ms
 }
+
+TEST_CASE("broadcast budget: the debt has a floor, so a flood's end frees the budget within two seconds") {
+    fn::BroadcastBudget budget(10);  // 100 ms per second
+    const fe::TimePoint t0{};
+    // An hour of stops charged at once: the balance stops at minus one second's worth.
+    for (int i = 0; i < 36'000; ++i) budget.charge(100ms, t0);
+    CHECK_FALSE(budget.take(1ms, t0 + 1000ms));  // refilled 100 ms: at 0
+    CHECK(budget.available_at(t0 + 1000ms) > t0 + 1000ms);
+    CHECK(budget.take(1ms, t0 + 1010ms));
+}
+
+TEST_CASE("broadcast budget: a broadcast that did not go out gives its share back") {
+    fn::BroadcastBudget budget(10);
+    const fe::TimePoint t0{};
+    CHECK(budget.take(150ms, t0));  // -50 ms
+    CHECK_FALSE(budget.take(1ms, t0));
+    budget.refund(150ms, t0);       // refused by the line's queue after all: 100 ms
+    CHECK(budget.take(1ms, t0));
+    // A refund never fills it past its capacity.
+    budget.refund(10s, t0);
+    CHECK(budget.take(100ms, t0));
+    CHECK_FALSE(budget.take(1ms, t0));
+}
+
+TEST_CASE("broadcast budget: available_at names the first instant take() succeeds") {
+    const fe::TimePoint t0{};
+    fn::BroadcastBudget early(10);
+    fn::BroadcastBudget on_time(10);
+    CHECK(early.available_at(t0) == t0);
+    CHECK(early.take(130ms, t0));  // -30 ms: 300 ms of refill to get back to 0
+    CHECK(on_time.take(130ms, t0));
+    const fe::TimePoint at = early.available_at(t0);
+    CHECK(at > t0 + 300ms);
+    CHECK(at < t0 + 301ms);
+    CHECK_FALSE(early.take(1ms, at - 1ns));
+    CHECK(on_time.take(1ms, at));
+}
