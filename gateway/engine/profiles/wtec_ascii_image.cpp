@@ -81,7 +81,12 @@ void store_gripper(RegisterImage& image, const wtec::GripperParams& params, std:
                params.home_at_power_up},
               now);
     put_holding(image, speed, wtec_raw_to_percent(params.speed, 0xFF), now);
-    put_holding(image, position, wtec_raw_to_percent(static_cast<std::int32_t>(params.target), stroke), now);
+    // 0x0105 shows the target the gripper was last sent, as the RTU mode's register
+    // does. `D` moves without changing N's target parameter, so N fills 0x0105 only
+    // until the first acknowledged `D`; after that N refreshes what `D` left.
+    const std::optional<std::uint16_t> sent = image.value(Table::holding, position);
+    put_holding(image, position,
+                sent ? *sent : wtec_raw_to_percent(static_cast<std::int32_t>(params.target), stroke), now);
     refresh_force(image, now);
 }
 
@@ -91,8 +96,7 @@ void store_peak_current(RegisterImage& image, std::uint8_t current, TimePoint no
 }
 
 void store_target(RegisterImage& image, std::int32_t target, std::uint32_t stroke, TimePoint now) {
-    const auto raw = static_cast<std::uint32_t>(target);
-    put_input(image, ext_n_target, {high(raw), low(raw)}, now);
+    // N's target (0x1006) is the device's parameter, which `D` does not change.
     put_holding(image, position, wtec_raw_to_percent(target, stroke), now);
 }
 

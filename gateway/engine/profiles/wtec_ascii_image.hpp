@@ -21,13 +21,14 @@ void store_running(RegisterImage& image, const protocol::wtec::RunningValues& va
 void store_grip_code(RegisterImage& image, std::uint8_t code, TimePoint now);
 /// `g`: raw homing code and 0x0200.
 void store_homing_code(RegisterImage& image, std::uint8_t code, TimePoint now);
-/// `N` (or an acknowledged `n`): extension fields, speed 0x0104, position 0x0105,
-/// and force 0x0103 when R is known.
+/// `N` (or an acknowledged `n`): extension fields, speed 0x0104, force 0x0103 when
+/// R is known, and position 0x0105 from N's target until an acknowledged `D` has set
+/// it (then N only refreshes it: `D` does not change N's target parameter).
 void store_gripper(RegisterImage& image, const protocol::wtec::GripperParams& params, std::uint32_t stroke,
                    TimePoint now);
 /// An acknowledged `C`: the grip current, i.e. N max current, and force 0x0103.
 void store_peak_current(RegisterImage& image, std::uint8_t current, TimePoint now);
-/// An acknowledged `D`: N target and position 0x0105.
+/// An acknowledged `D`: position 0x0105, the target last sent.
 void store_target(RegisterImage& image, std::int32_t target, std::uint32_t stroke, TimePoint now);
 /// `R`: extension fields and force 0x0103 when N is known.
 void store_driver(RegisterImage& image, const protocol::wtec::DriverParams& params, TimePoint now);

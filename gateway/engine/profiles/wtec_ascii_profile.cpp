@@ -279,10 +279,7 @@ std::vector<Payload> WtecAsciiProfile::to_line(const protocol::Request& request,
             }
             case position: {
                 const auto target = static_cast<std::int32_t>(wtec_percent_to_raw(value, stroke_));
-                out.push_back(AsciiPayload{wtec::SetTarget{target}});
-                if (n) {
-                    n->target = static_cast<std::uint32_t>(target);
-                }
+                out.push_back(AsciiPayload{wtec::SetTarget{target}});  // N's target stays
                 break;
             }
             case init_direction: {

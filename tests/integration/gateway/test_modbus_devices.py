@@ -256,6 +256,11 @@ class WtecEstopRecovery(gatewaylib.CellTestCase):
         # Initialise (ASCII: a1 then G) unlocks and homes both; then the move is done.
         self.step(client, 0x0100, 1, [0, 1, 1, 0], "after the initialise")
         self.step(client, 0x0105, 30, [0, 1, 1, 30], "after the move")
+        # 0x0105 reads the target last sent in both modes, also after the ASCII view's
+        # slow poll (N, 1 s) has come round twice (issue 24 item 5).
+        time.sleep(2.2)
+        for unit in (WTEC_ASCII, WTEC_RTU):
+            self.assertEqual(self.read_holding(client, 0x0105, 1, unit), [30], "0x0105 of unit %d" % unit)
 
 
 class BroadcastUnit(gatewaylib.CellTestCase):

@@ -242,6 +242,34 @@ TEST_CASE("wtec-ascii: an E or D the gripper echoes back was not executed: 0x04,
           fp::Response{fp::ExceptionResponse{0x10, ExceptionCode::server_device_failure}});
 }
 
+TEST_CASE("wtec-ascii: 0x0105 shows the target last sent, whatever N's target parameter says (issue 24 item 5)") {
+    View v;
+    v.polled();  // N's target 5000 of 10000: 50 %
+    CHECK(v.image.value(Table::holding, 0x0105) == 50);
+    // e-stop, initialise, move to 30 %: D 3000 acknowledged.
+    CHECK(v.exchange(write_single(0x0102, 1), {fw::Ack{}}) == fp::Response{fp::WriteSingleResponse{0x06, 0x0102, 1}});
+    CHECK(v.exchange(write_single(0x0100, 1), {fw::Ack{}, fw::Ack{}}) ==
+          fp::Response{fp::WriteSingleResponse{0x06, 0x0100, 1}});
+    CHECK(v.exchange(write_single(0x0105, 30), {fw::Ack{}}) == fp::Response{fp::WriteSingleResponse{0x06, 0x0105, 30}});
+    CHECK(v.image.value(Table::holding, 0x0105) == 30);
+    // D moved the jaws without changing N's target (the manual's example device keeps
+    // 0x5C44 there): the next N poll leaves 0x0105 at what was sent.
+    (void)v.feed(fw::ReadGripper{}, gripper(0x5C44, 80, 0xFF));
+    CHECK(v.image.value(Table::holding, 0x0105) == 30);
+    CHECK(values_of(v.image, Table::input, 0x1006, 2) == std::vector<std::uint16_t>{0, 0x5C44});
+    // A speed write sends `n` with N's target as the device has it, not D's.
+    const auto speed = v.profile.to_line(write_single(0x0104, 50), v.image);
+    REQUIRE(speed.size() == 1);
+    CHECK(std::get<fw::WriteGripper>(command_of(speed[0])).params.target == 0x5C44);
+    CHECK(v.exchange(write_single(0x0104, 50), {fw::Ack{}}) == fp::Response{fp::WriteSingleResponse{0x06, 0x0104, 50}});
+    CHECK(v.image.value(Table::holding, 0x0105) == 30);
+    // A D the gripper did not execute leaves it as it was.
+    CHECK(v.exchange(write_single(0x0105, 70), {fw::NotExecuted{}}) ==
+          fp::Response{fp::ExceptionResponse{0x06, ExceptionCode::server_device_failure}});
+    (void)v.feed(fw::ReadGripper{}, gripper(0x5C44, 80, 0xFF));
+    CHECK(v.image.value(Table::holding, 0x0105) == 30);
+}
+
 TEST_CASE("wtec-ascii: on-demand reads send the commands that fill what is asked") {
     const View v;
     CHECK(v.letters(read_holding(0x0200, 1)) == "g");
@@ -331,7 +359,8 @@ TEST_CASE("wtec-ascii: acknowledged writes update the view; the e-stop latch") {
     v.polled();
     CHECK(v.exchange(write_single(0x0105, 25), {fw::Ack{}}) == fp::Response{fp::WriteSingleResponse{0x06, 0x0105, 25}});
     CHECK(v.image.value(Table::holding, 0x0105) == 25);
-    CHECK(values_of(v.image, Table::input, 0x1006, 2) == std::vector<std::uint16_t>{0, 2500});  // N target
+    // N's target parameter (5000, polled) stays: `D` does not change it.
+    CHECK(values_of(v.image, Table::input, 0x1006, 2) == std::vector<std::uint16_t>{0, 5000});
 
     CHECK(v.exchange(write_multiple(0x0103, {60, 1}), {fw::Ack{}, fw::Ack{}}) ==
           fp::Response{fp::WriteMultipleResponse{0x10, 0x0103, 2}});
