@@ -52,6 +52,7 @@ const DeviceAgentConfig& DeviceAgent::config() const noexcept { return impl_->co
 bool DeviceAgent::online() const noexcept { return impl_->online(); }
 std::size_t DeviceAgent::poll_items() const noexcept { return impl_->poll_items(); }
 bool DeviceAgent::motion_polling() const noexcept { return impl_->motion_polling(); }
+std::size_t DeviceAgent::requests_in_progress() const noexcept { return impl_->requests_in_progress(); }
 
 // ---- Impl: lifetime and health ---------------------------------------------------
 

@@ -26,7 +26,7 @@
 ///    protocol/gateway_exceptions.hpp; the table in docs/modbus-tcp.md): timeout /
 ///    device_offline / expired -> 0x0B, queue_full -> 0x06, line_down and cancelled
 ///    (also a sequence the agent's stop() or destruction cut short) -> 0x0A,
-///    invalid_request -> 0x04.
+///    invalid_request, bad_reply (the device answered something that does not fit) -> 0x04.
 ///  - A reply's follow_up (XEG exception 0x04 -> FC07) is submitted as an on-demand
 ///    read (one at a time); a DeviceNotice is logged and reported to the notice
 ///    callback.
@@ -116,6 +116,8 @@ public:
     /// Poll items currently planned (after splits) and whether motion polling is on.
     [[nodiscard]] std::size_t poll_items() const noexcept;
     [[nodiscard]] bool motion_polling() const noexcept;
+    /// Client requests taken and not answered yet (a retired agent is kept until 0).
+    [[nodiscard]] std::size_t requests_in_progress() const noexcept;
 
 private:
     class Impl;

@@ -21,7 +21,8 @@ protocol::GatewayRefusal refusal_for(OutcomeStatus status) noexcept {
         case OutcomeStatus::cancelled: return GatewayRefusal::cancelled;
         case OutcomeStatus::ok:  // an ok outcome without a usable reply
         case OutcomeStatus::broadcast_sent:
-        case OutcomeStatus::invalid_request: break;
+        case OutcomeStatus::invalid_request:
+        case OutcomeStatus::bad_reply: break;
     }
     return GatewayRefusal::gateway_failure;
 }

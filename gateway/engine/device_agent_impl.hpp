@@ -53,6 +53,7 @@ public:
     [[nodiscard]] bool online() const noexcept { return online_; }
     [[nodiscard]] std::size_t poll_items() const noexcept { return polls_.plan().items().size(); }
     [[nodiscard]] bool motion_polling() const noexcept { return polls_.motion(); }
+    [[nodiscard]] std::size_t requests_in_progress() const noexcept { return operations_.size(); }
 
 private:
     enum class State : std::uint8_t { idle, running, stopped };

@@ -107,7 +107,7 @@ void DeviceAgent::Impl::on_poll_done(std::uint32_t id, const Outcome& outcome) {
         // A read that timed out leaves its registers stale (not fresh for reads, and
         // MQTT says so). Other failures never reached the device: queue full, line
         // down or the device offline (the image says offline already), cancelled.
-        if (outcome.status == OutcomeStatus::timeout) {
+        if (outcome.status == OutcomeStatus::timeout || outcome.status == OutcomeStatus::bad_reply) {
             mark_stale();
         }
         if (log_.enabled(LogLevel::debug)) {

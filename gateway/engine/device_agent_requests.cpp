@@ -88,7 +88,7 @@ void DeviceAgent::Impl::on_step_done(const OperationPtr& op, const Outcome& outc
     }
     const TimePoint now = outcome_time(outcome);
     if (outcome.status != OutcomeStatus::ok) {
-        if (outcome.status == OutcomeStatus::timeout) {
+        if (outcome.status == OutcomeStatus::timeout || outcome.status == OutcomeStatus::bad_reply) {
             // Unanswered read, or a write whose effect is unknown (the device may
             // have acted, rule 6): what it covers is no longer known to be current.
             if (const std::optional<RequestSpan> span = request_span(op->request)) {

@@ -37,20 +37,39 @@ namespace {
     return left == right;
 }
 
+/// @p device without what retune() and the scheduler's update_device() take, and what
+/// only routing reads.
+[[nodiscard]] config::DeviceConfig without_agent_settings(config::DeviceConfig device) {
+    device.max_age = {};
+    device.command_ttl = {};
+    device.delay_before_command = {};
+    device.queue_limit = 0;
+    device.unit_id = {};
+    device.mqtt_commands = false;
+    return device;
+}
+
 /// A device whose profile and agent settings are unchanged but for what retune()
 /// and the scheduler's update_device() take, and what only routing reads.
 [[nodiscard]] bool retunable(const config::DeviceConfig& a, const config::DeviceConfig& b) {
-    config::DeviceConfig left = a;
-    config::DeviceConfig right = b;
-    for (auto* device : {&left, &right}) {
-        device->max_age = {};
-        device->command_ttl = {};
-        device->delay_before_command = {};
-        device->queue_limit = 0;
-        device->unit_id = {};
-        device->mqtt_commands = false;
-    }
-    return left == right;
+    return without_agent_settings(a) == without_agent_settings(b);
+}
+
+/// @p device without what does not change what its registers mean: the agent's
+/// settings, poll periods and protection.
+[[nodiscard]] config::DeviceConfig register_meaning(const config::DeviceConfig& device) {
+    config::DeviceConfig meaning = without_agent_settings(device);
+    meaning.poll = {};
+    meaning.allow_protected = false;
+    for (auto& block : meaning.blocks) block.period = {};
+    return meaning;
+}
+
+/// A swapped device whose registers mean what they meant (same device type, bus
+/// address, word order, stroke and blocks): the new agent may start from the old one's
+/// register image.
+[[nodiscard]] bool same_registers(const config::DeviceConfig& a, const config::DeviceConfig& b) {
+    return register_meaning(a) == register_meaning(b);
 }
 
 [[nodiscard]] const config::DeviceConfig* find_device_config(const config::LineConfig& line,
@@ -167,10 +186,14 @@ void Engine::index_devices() {
 void Engine::update_line(LineEntry& entry, const config::LineConfig& line, ReloadReport& report) {
     const TimePoint now = Clock::now();
     auto& scheduler = entry.worker->scheduler();
-    // Agents retired by the previous reload have had their time: their requests went
-    // out long ago (a reload is an operator's act, not a burst).
-    for (auto& agent : entry.retired) entry.worker->remove_device(agent->config().index, OutcomeStatus::cancelled);
-    entry.retired.clear();
+    // Agents retired by earlier reloads leave once drained: what they had queued still
+    // goes out and is answered (docs/service.md, "Reload"), even in a storm of reloads.
+    std::erase_if(entry.retired, [&](const std::unique_ptr<DeviceAgent>& agent) {
+        const DeviceIndex index = agent->config().index;
+        if (scheduler.queued(index) != 0 || agent->requests_in_progress() != 0) return false;
+        entry.worker->remove_device(index, OutcomeStatus::cancelled);
+        return true;
+    });
 
     std::vector<std::unique_ptr<DeviceAgent>> old_agents = std::move(entry.agents);
     entry.agents.clear();
@@ -195,8 +218,14 @@ void Engine::update_line(LineEntry& entry, const config::LineConfig& line, Reloa
             entry.agents.push_back(std::move(agent));
         } else {
             auto replacement = build_agent(entry, line, device);
+            if (agent && before != nullptr && same_registers(*before, device)) {
+                // The same registers of the same device: the cache stays warm, so the
+                // clients it serves do not all go to the line at once.
+                replacement->image().adopt(agent->image());
+            }
             if (agent) {
                 agent->stop();
+                entry.worker->drop_polls(agent->config().index);
                 entry.retired.push_back(std::move(agent));
                 report.devices_replaced.push_back(device.name);
             } else {
@@ -210,6 +239,7 @@ void Engine::update_line(LineEntry& entry, const config::LineConfig& line, Reloa
         if (!agent) continue;
         report.devices_removed.push_back(agent->config().name);
         agent->stop();
+        entry.worker->drop_polls(agent->config().index);
         entry.retired.push_back(std::move(agent));
     }
     set_broadcast(entry, line);

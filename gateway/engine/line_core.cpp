@@ -143,7 +143,11 @@ void LineCore::on(TimePoint now, line_event::Submit& event, LineStep& step) {
 }
 
 void LineCore::on(TimePoint now, line_event::RemoveDevice& event, LineStep&) {
-    scheduler_.remove_device(event.device, event.status, now);
+    if (event.polls_only) {
+        scheduler_.drop_polls(event.device, event.status, now);
+    } else {
+        scheduler_.remove_device(event.device, event.status, now);
+    }
 }
 
 void LineCore::request_drive(LineStep& step) {

@@ -95,6 +95,9 @@ struct Submit {
 struct RemoveDevice {
     DeviceIndex device = 0;
     OutcomeStatus status = OutcomeStatus::cancelled;
+    /// Only its queued polls go (a retired agent's: nobody waits for them); the
+    /// device and its other requests stay until they drain.
+    bool polls_only = false;
 };
 /// The Drive the step asked to post runs now.
 struct Drive {};

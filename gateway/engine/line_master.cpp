@@ -295,7 +295,18 @@ void LineMaster::scan(TimePoint now) {
         ReplyScan result = scan_reply(rx_, *transaction_);
         if (result.kind == ReplyScan::Kind::need_more || result.consumed == 0) return;
         if (result.kind == ReplyScan::Kind::dropped) {
+            // A whole frame from the device asked (its address, a good CRC) that does
+            // not answer the request (a length or an echo that does not fit): the
+            // device did answer, so say so now instead of waiting for a timeout.
+            const bool misfit = result.framed && result.error != protocol::DecodeError::wrong_address;
             drop(std::min(result.consumed, rx_.size()), result.error, result.framed);
+            if (misfit) {
+                counters_.garbage_bytes += rx_.size();
+                rx_.clear();
+                guard_until_ = now + config_.turnaround;
+                finish(OutcomeStatus::bad_reply, {}, now, "reply does not fit the request");
+                return;
+            }
             continue;
         }
         counters_.garbage_bytes += result.skipped;

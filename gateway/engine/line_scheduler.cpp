@@ -102,6 +102,20 @@ void LineScheduler::remove_device(DeviceIndex device, OutcomeStatus status, Time
     devices_.erase(it);
 }
 
+void LineScheduler::drop_polls(DeviceIndex device, OutcomeStatus status, TimePoint now) {
+    Device* known = find(device);
+    if (known == nullptr) return;
+    auto& queue = known->queue;
+    const auto polls = std::stable_partition(queue.begin(), queue.end(), [](const Entry& entry) {
+        return entry.transaction.priority != Priority::poll;
+    });
+    for (auto it = polls; it != queue.end(); ++it) {
+        --known->stats.by_class[class_index(it->transaction.priority)].depth;
+        reject(std::move(it->transaction), status, now);
+    }
+    queue.erase(polls, queue.end());
+}
+
 LineScheduler::Device* LineScheduler::find(DeviceIndex device) noexcept {
     const auto it = devices_.find(device);
     return it == devices_.end() ? nullptr : &it->second;
@@ -355,7 +369,9 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
         return;
     }
     const DeviceIndex index = transaction.device;
-    if (outcome.status == OutcomeStatus::ok) {
+    if (outcome.status == OutcomeStatus::ok || outcome.status == OutcomeStatus::bad_reply) {
+        // A reply that does not fit the request is still an answer: the device is
+        // there (never counted toward taking it offline); it is not retried.
         device->consecutive_timeouts = 0;
         if (const auto* response = std::get_if<protocol::Response>(&outcome.reply);
             response != nullptr && std::holds_alternative<protocol::ExceptionResponse>(*response)) {

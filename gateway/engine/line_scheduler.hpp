@@ -64,7 +64,7 @@ namespace fieldbridge::engine {
 
 /// Number of OutcomeStatus values (for per-status counters).
 inline constexpr std::size_t outcome_status_count =
-    static_cast<std::size_t>(OutcomeStatus::invalid_request) + 1;
+    static_cast<std::size_t>(OutcomeStatus::bad_reply) + 1;
 inline constexpr std::size_t priority_count = 3;
 
 /// Per-device queue and health policy (config: device `queue_limit`, line
@@ -146,6 +146,9 @@ public:
     /// Reload: forgets @p device. Its queued transactions complete with @p status; one
     /// in flight still completes through finished(). Unknown devices are ignored.
     void remove_device(DeviceIndex device, OutcomeStatus status, TimePoint now);
+    /// Reload: completes @p device's queued polls with @p status (its agent was
+    /// retired: nobody waits for them); its other requests stay queued.
+    void drop_polls(DeviceIndex device, OutcomeStatus status, TimePoint now);
 
     /// Queues @p transaction (sets id and enqueued), or completes it at once:
     /// `invalid_request` for an unknown device,

@@ -60,8 +60,9 @@ public:
     void stop() { feed(line_event::Stop{}); }
 
     void remove_device(DeviceIndex device, OutcomeStatus status) {
-        feed(line_event::RemoveDevice{device, status});
+        feed(line_event::RemoveDevice{device, status, false});
     }
+    void drop_polls(DeviceIndex device) { feed(line_event::RemoveDevice{device, OutcomeStatus::cancelled, true}); }
 
     void submit(Transaction transaction) {
         const LineStep step = core_.handle(seams_.now(), line_event::Submit{std::move(transaction)});
@@ -235,6 +236,7 @@ void LineWorker::start() { impl_->start(); }
 void LineWorker::stop() { impl_->stop(); }
 void LineWorker::submit(Transaction transaction) { impl_->submit(std::move(transaction)); }
 void LineWorker::remove_device(DeviceIndex device, OutcomeStatus status) { impl_->remove_device(device, status); }
+void LineWorker::drop_polls(DeviceIndex device) { impl_->drop_polls(device); }
 bool LineWorker::line_up() const noexcept { return impl_->line_up(); }
 const LineMaster& LineWorker::master() const noexcept { return impl_->master(); }
 const LineWorkerConfig& LineWorker::config() const noexcept { return impl_->config(); }

@@ -83,6 +83,9 @@ public:
     /// Reload: forgets @p device; its queued transactions complete with @p status
     /// before this returns, one in flight completes with its outcome.
     void remove_device(DeviceIndex device, OutcomeStatus status);
+    /// Reload: @p device's agent was retired; its queued polls complete `cancelled`
+    /// before this returns, its queued requests stay and still go out.
+    void drop_polls(DeviceIndex device);
 
     [[nodiscard]] bool line_up() const noexcept;
     [[nodiscard]] const LineMaster& master() const noexcept;

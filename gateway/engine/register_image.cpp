@@ -98,6 +98,19 @@ void RegisterImage::mark_stale(Table table, std::uint16_t address, std::uint16_t
     }
 }
 
+void RegisterImage::adopt(const RegisterImage& other) {
+    tables_ = other.tables_;
+    offline_ = other.offline_;
+    for (std::size_t t = 0; t < table_count; ++t) {
+        const Slots& s = tables_[t];
+        if (s.empty()) continue;
+        ImageChange change{static_cast<Table>(t), {}};
+        change.addresses.reserve(s.size());
+        for (const RegisterEntry& e : s) change.addresses.push_back(e.address);
+        notify(change);
+    }
+}
+
 void RegisterImage::set_offline(bool offline) {
     if (offline == offline_) {
         return;

@@ -109,6 +109,12 @@ public:
     /// A copy of entries(@p table).
     [[nodiscard]] std::vector<RegisterEntry> snapshot(Table table) const;
 
+    /// Takes @p other's registers (values, qualities, times) and its offline state,
+    /// then notifies subscribers of every register it now holds; its own
+    /// subscriptions stay. For a device swapped by a reload that reads the same
+    /// registers of the same device, so the cache stays warm.
+    void adopt(const RegisterImage& other);
+
     /// Registers @p listener; it is called synchronously after every change, on the
     /// thread that changed the image. A listener may unsubscribe (itself or others)
     /// and may subscribe new listeners (they see the next change) while called. A

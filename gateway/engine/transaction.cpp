@@ -13,6 +13,7 @@ const char* to_string(OutcomeStatus status) noexcept {
         case OutcomeStatus::cancelled: return "cancelled";
         case OutcomeStatus::broadcast_sent: return "broadcast_sent";
         case OutcomeStatus::invalid_request: return "invalid_request";
+        case OutcomeStatus::bad_reply: return "bad_reply";
     }
     return "unknown";
 }

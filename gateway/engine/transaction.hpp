@@ -49,6 +49,7 @@ enum class OutcomeStatus : std::uint8_t {
     cancelled,       ///< shut down or reconfigured before it was sent
     broadcast_sent,  ///< broadcast written and the silence observed; no reply expected
     invalid_request, ///< cannot be carried (unknown device, unencodable request): never sent
+    bad_reply,       ///< the device answered, with a frame (good CRC, its address) that does not fit the request
 };
 
 [[nodiscard]] const char* to_string(OutcomeStatus status) noexcept;

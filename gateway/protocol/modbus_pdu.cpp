@@ -89,6 +89,7 @@ std::uint8_t function_of(const Request& request) noexcept {
             [](const ReadExceptionStatusRequest&) { return fc::read_exception_status; },
             [](const WriteMultipleCoilsRequest&) { return fc::write_multiple_coils; },
             [](const WriteMultipleRegistersRequest&) { return fc::write_multiple_registers; },
+            [](const MaskWriteRegisterRequest&) { return fc::mask_write_register; },
             [](const ReadWriteRegistersRequest&) { return fc::read_write_multiple_registers; },
             [](const OpaqueRequest& r) { return r.function; },
         },
@@ -176,6 +177,12 @@ Bytes encode_request(const Request& request) {
                 put_u16_be(out, static_cast<std::uint16_t>(r.values.size()));
                 out.push_back(static_cast<std::uint8_t>(2 * r.values.size()));
                 put_registers(out, r.values);
+            },
+            [&out](const MaskWriteRegisterRequest& r) {
+                out.push_back(fc::mask_write_register);
+                put_u16_be(out, r.address);
+                put_u16_be(out, r.and_mask);
+                put_u16_be(out, r.or_mask);
             },
             [&out](const ReadWriteRegistersRequest& r) {
                 constexpr std::uint8_t function = fc::read_write_multiple_registers;
@@ -310,6 +317,10 @@ DecodeResult<Request> decode_request(ByteView pdu) {
         case fc::write_multiple_coils:
         case fc::write_multiple_registers:
             return decode_write_multiple(pdu);
+        case fc::mask_write_register:
+            if (size != mask_write_pdu_size) return RequestResult::bad(DecodeError::bad_length, size);
+            return RequestResult::ok(MaskWriteRegisterRequest{get_u16_be(pdu, 1), get_u16_be(pdu, 3), get_u16_be(pdu, 5)},
+                                     size);
         case fc::read_write_multiple_registers:
             return decode_read_write(pdu);
         default:
@@ -336,6 +347,8 @@ std::optional<PredictedLength> predict_request_pdu_length(ByteView pdu_prefix) {
         case fc::write_multiple_registers:
             if (pdu_prefix.size() < write_multiple_header_size) return PredictedLength{};
             return known_length(write_multiple_header_size + pdu_prefix[5]);
+        case fc::mask_write_register:
+            return known_length(mask_write_pdu_size);
         case fc::read_write_multiple_registers:
             if (pdu_prefix.size() < read_write_header_size) return PredictedLength{};
             return known_length(read_write_header_size + pdu_prefix[9]);

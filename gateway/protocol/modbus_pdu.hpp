@@ -27,6 +27,8 @@ inline constexpr core::FunctionCode write_single_register{0x06};
 inline constexpr core::FunctionCode read_exception_status{0x07};
 inline constexpr core::FunctionCode write_multiple_coils{0x0F};
 inline constexpr core::FunctionCode write_multiple_registers{0x10};
+inline constexpr core::FunctionCode report_server_id{0x11};
+inline constexpr core::FunctionCode mask_write_register{0x16};
 inline constexpr core::FunctionCode read_write_multiple_registers{0x17};
 }  // namespace fn
 
@@ -42,6 +44,8 @@ inline constexpr std::uint8_t write_single_register = fn::write_single_register.
 inline constexpr std::uint8_t read_exception_status = fn::read_exception_status.value;
 inline constexpr std::uint8_t write_multiple_coils = fn::write_multiple_coils.value;
 inline constexpr std::uint8_t write_multiple_registers = fn::write_multiple_registers.value;
+inline constexpr std::uint8_t report_server_id = fn::report_server_id.value;
+inline constexpr std::uint8_t mask_write_register = fn::mask_write_register.value;
 inline constexpr std::uint8_t read_write_multiple_registers = fn::read_write_multiple_registers.value;
 /// Bit 7 of the function byte: set in an exception reply (section 7).
 inline constexpr std::uint8_t exception_flag = 0x80;
@@ -112,7 +116,19 @@ struct WriteMultipleRegistersRequest {
     std::vector<std::uint16_t> values;
     bool operator==(const WriteMultipleRegistersRequest&) const = default;
 };
-/// FC17: the write is performed before the read.
+/// FC16 (mask write register): the register becomes (current AND and_mask) OR (or_mask AND NOT and_mask)
+/// (Modbus Application Protocol 6.16).
+struct MaskWriteRegisterRequest {
+    std::uint16_t address = 0;
+    std::uint16_t and_mask = 0;
+    std::uint16_t or_mask = 0;
+    bool operator==(const MaskWriteRegisterRequest&) const = default;
+    /// What the register holds after the write, from what it held before.
+    [[nodiscard]] constexpr std::uint16_t applied_to(std::uint16_t current) const noexcept {
+        return static_cast<std::uint16_t>((current & and_mask) | (or_mask & ~and_mask));
+    }
+};
+/// FC17 (read/write multiple registers): the write is performed before the read.
 struct ReadWriteRegistersRequest {
     std::uint16_t read_address = 0;
     std::uint16_t read_count = 0;
@@ -130,7 +146,7 @@ struct OpaqueRequest {
 using Request = std::variant<ReadBitsRequest, ReadRegistersRequest, WriteSingleCoilRequest,
                              WriteSingleRegisterRequest, ReadExceptionStatusRequest,
                              WriteMultipleCoilsRequest, WriteMultipleRegistersRequest,
-                             ReadWriteRegistersRequest, OpaqueRequest>;
+                             MaskWriteRegisterRequest, ReadWriteRegistersRequest, OpaqueRequest>;
 
 // ---- responses ------------------------------------------------------------------
 
@@ -165,6 +181,13 @@ struct WriteMultipleResponse {
     std::uint16_t count = 0;
     bool operator==(const WriteMultipleResponse&) const = default;
 };
+/// FC16 (mask write register): the echo of the request (6.16).
+struct MaskWriteResponse {
+    std::uint16_t address = 0;
+    std::uint16_t and_mask = 0;
+    std::uint16_t or_mask = 0;
+    bool operator==(const MaskWriteResponse&) const = default;
+};
 /// Function code with 0x80 set; `function` holds the code without the flag.
 struct ExceptionResponse {
     std::uint8_t function = 0;
@@ -178,7 +201,7 @@ struct OpaqueResponse {
 };
 
 using Response = std::variant<ReadBitsResponse, ReadRegistersResponse, WriteSingleResponse,
-                              ReadExceptionStatusResponse, WriteMultipleResponse,
+                              ReadExceptionStatusResponse, WriteMultipleResponse, MaskWriteResponse,
                               ExceptionResponse, OpaqueResponse>;
 
 // ---- codec ----------------------------------------------------------------------

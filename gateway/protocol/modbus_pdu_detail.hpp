@@ -19,6 +19,7 @@ inline constexpr std::uint16_t coil_off = 0x0000;
 inline constexpr std::size_t address_value_pdu_size = 5;      // FC01-06 requests, FC05/06/0F/10 replies
 inline constexpr std::size_t read_exception_status_request_size = 1;  // FC07: function code only
 inline constexpr std::size_t write_multiple_header_size = 6;  // FC0F/10: fc, address, count, byte count
+inline constexpr std::size_t mask_write_pdu_size = 7;         // FC16 request and reply: fc, address, and, or
 inline constexpr std::size_t read_write_header_size = 10;     // FC17: fc, 2 x (address, count), byte count
 inline constexpr std::size_t byte_count_reply_header_size = 2;  // fc + byte count
 inline constexpr std::size_t two_byte_pdu_size = 2;           // exception reply, FC07 reply

@@ -45,6 +45,9 @@ std::optional<ExpectedReply> expected_reply(const Request& request) {
                 return ExpectedReply{two_byte_pdu_size, 0};
             },
             [](const OpaqueRequest&) -> std::optional<ExpectedReply> { return std::nullopt; },
+            [](const MaskWriteRegisterRequest&) -> std::optional<ExpectedReply> {
+                return ExpectedReply{mask_write_pdu_size, 0};
+            },
             // FC05 / FC06 / FC0F / FC10: address and value or quantity (6.5, 6.6, 6.11, 6.12).
             [](const auto&) -> std::optional<ExpectedReply> {
                 return ExpectedReply{address_value_pdu_size, 0};
@@ -105,6 +108,14 @@ ResponseResult decode_normal(ByteView pdu, const Request& request) {
     if (function == fc::read_exception_status) {
         return ResponseResult::ok(ReadExceptionStatusResponse{pdu[1]}, size);
     }
+    if (const auto* mask = std::get_if<MaskWriteRegisterRequest>(&request)) {
+        // 6.16: the reply echoes the request.
+        const MaskWriteResponse echo{get_u16_be(pdu, 1), get_u16_be(pdu, 3), get_u16_be(pdu, 5)};
+        if (echo.address != mask->address || echo.and_mask != mask->and_mask || echo.or_mask != mask->or_mask) {
+            return ResponseResult::bad(DecodeError::unexpected_reply, size);
+        }
+        return ResponseResult::ok(echo, size);
+    }
     const Echo echo{get_u16_be(pdu, 1), get_u16_be(pdu, 3)};
     const auto want = expected_echo(request);
     if (!want || echo.address != want->address || echo.value != want->value) {
@@ -161,6 +172,12 @@ Bytes encode_response(const Response& response) {
                 out.push_back(r.function);
                 put_u16_be(out, r.address);
                 put_u16_be(out, r.count);
+            },
+            [&out](const MaskWriteResponse& r) {
+                out.push_back(fc::mask_write_register);
+                put_u16_be(out, r.address);
+                put_u16_be(out, r.and_mask);
+                put_u16_be(out, r.or_mask);
             },
             [&out](const ExceptionResponse& r) { out = encode_exception(r.function, r.code); },
             [&out](const OpaqueResponse& r) {

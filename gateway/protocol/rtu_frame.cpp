@@ -8,7 +8,9 @@
 //    candidate are reported malformed (drop them), or need_more if it starts at 0;
 //  - otherwise nothing in the buffer can become a frame: all of it is malformed.
 // A candidate is rejected only for reasons more bytes cannot change (address,
-// function, byte count, CRC over the predicted length), so dropping is always safe.
+// function, CRC over the predicted length or, for a read reply whose byte count
+// disagrees with the request, over the length that byte count gives), so dropping is
+// always safe.
 // The error reported for dropped bytes is the first one's, unless a later start got as
 // far as the CRC (see weight()), so a corrupted reply behind noise counts as bad_crc.
 //
@@ -165,12 +167,16 @@ DecodeResult<RtuFrame> frame_rtu_response(ByteView rx, std::uint8_t address, con
         if (predicted->length + rtu_overhead > max_rtu_adu_size) {
             return rejected(DecodeError::oversize);
         }
-        // Reads: the byte count must be the one the request implies. A reply that
-        // disagrees cannot be the answer, whatever follows (libmodbus frames by this
-        // byte; here it only confirms the length predicted from the request).
+        // Reads: a byte count other than the one the request implies cannot be the
+        // answer. The device may still have sent a whole frame of that length (a
+        // firmware that answers fewer registers than asked): framed by its own byte
+        // count, as libmodbus frames, a good CRC makes it the device's reply, which
+        // decode_response() then refuses (unexpected_reply), so the master answers at
+        // once instead of waiting for a length that never comes.
         if (pdu[0] == function && reply_has_byte_count(function) && pdu.size() >= 2 &&
             pdu[1] + std::size_t{2} != predicted->length) {
-            return rejected(DecodeError::unexpected_reply);
+            const Candidate own = judge_known_length(at, pdu[1] + std::size_t{2});
+            return own.verdict == Verdict::rejected ? rejected(DecodeError::unexpected_reply) : own;
         }
         return judge_known_length(at, predicted->length);
     });

@@ -81,9 +81,12 @@ void check_block(const GenericBlock& b) {
 
 [[nodiscard]] WireFunctions generic_wire_functions() {
     namespace fn = protocol::fn;
+    // What libmodbus' server and mbusd carry too: report server ID (FC11), mask write
+    // (FC16) and read/write multiple registers (FC17), through the same block checks.
     return WireFunctions{{fn::read_coils, fn::read_discrete_inputs, fn::read_holding_registers,
                           fn::read_input_registers, fn::write_single_coil, fn::write_single_register,
-                          fn::write_multiple_coils, fn::write_multiple_registers},
+                          fn::write_multiple_coils, fn::write_multiple_registers, fn::report_server_id,
+                          fn::mask_write_register, fn::read_write_multiple_registers},
                          false, false};
 }
 

@@ -3,7 +3,9 @@
 /// A generic Modbus-RTU device: its register blocks and poll periods come from the
 /// configuration (spec §5). The blocks are the known map: a request outside them
 /// is answered 0x02 locally; writes are allowed only to writable blocks of coils
-/// and holding registers. Adjacent blocks with the same period are read together.
+/// and holding registers. Function codes: 01-06, 0F, 10, and 11 (report server ID,
+/// passed through), 16 (mask write: the register is read again after it) and 17
+/// (read/write multiple registers: both spans checked against the blocks). Adjacent blocks with the same period are read together.
 /// Nothing is decoded (MQTT shows the raw registers); no alarms, never in motion, no
 /// MQTT operations beyond the raw register ops.
 

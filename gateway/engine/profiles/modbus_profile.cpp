@@ -246,6 +246,23 @@ ApplyResult ModbusProfile::apply(const Payload& sent, const Reply& reply, Regist
                 }
                 const std::optional<RequestSpan> span = request_span(req);
                 store(image, span->table, span->address, span->values, true, true, now);
+            } else if constexpr (std::is_same_v<T, protocol::MaskWriteRegisterRequest>) {
+                if (!std::holds_alternative<protocol::MaskWriteResponse>(*response)) {
+                    handled = false;
+                    return;
+                }
+                // What the register holds now depends on what it held: read it again.
+                image.mark_stale(Table::holding, r.address, 1);
+            } else if constexpr (std::is_same_v<T, protocol::ReadWriteRegistersRequest>) {
+                const auto* regs = std::get_if<protocol::ReadRegistersResponse>(response);
+                if (regs == nullptr || protocol::function_code(*regs) != protocol::function_code(r) ||
+                    regs->values.size() != r.read_count) {
+                    handled = false;
+                    return;
+                }
+                // FC17 writes first, then reads (Modbus Application Protocol 6.17).
+                store(image, Table::holding, r.write_address, r.values, true, true, now);
+                store(image, Table::holding, r.read_address, regs->values, true, false, now);
             } else {
                 handled = false;
             }

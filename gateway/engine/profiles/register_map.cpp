@@ -39,8 +39,15 @@ std::optional<RequestSpan> request_span(const protocol::Request& request) {
             } else if constexpr (std::is_same_v<T, protocol::WriteMultipleRegistersRequest>) {
                 return RequestSpan{Table::holding, r.address, static_cast<std::uint16_t>(r.values.size()), true,
                                    r.values};
+            } else if constexpr (std::is_same_v<T, protocol::MaskWriteRegisterRequest>) {
+                // The value written depends on what the register holds: none is known.
+                return RequestSpan{Table::holding, r.address, 1, true, {}};
+            } else if constexpr (std::is_same_v<T, protocol::ReadWriteRegistersRequest>) {
+                // FC17 writes before it reads: the write is its span (validate_request() checks the read).
+                return RequestSpan{Table::holding, r.write_address, static_cast<std::uint16_t>(r.values.size()), true,
+                                   r.values};
             } else {
-                return std::nullopt;  // FC07, FC17, opaque: no single span
+                return std::nullopt;  // FC07, opaque (FC11 report server ID...): no span
             }
         },
         request);
@@ -151,6 +158,18 @@ std::optional<protocol::ExceptionCode> validate_request(const RegisterMap& map, 
     if (std::find(functions.begin(), functions.end(), function) == functions.end()) {
         return protocol::ExceptionCode::illegal_function;
     }
+    if (const auto* opaque = std::get_if<protocol::OpaqueRequest>(&request)) {
+        // FC11 report server ID carries no data (Modbus Application Protocol 6.13);
+        // other opaque codes are the profile's to list and the device's to judge.
+        const bool bad_length = function == protocol::fn::report_server_id && !opaque->data.empty();
+        return bad_length ? std::optional{protocol::ExceptionCode::illegal_data_value} : std::nullopt;
+    }
+    if (const auto* rw = std::get_if<protocol::ReadWriteRegistersRequest>(&request)) {
+        // FC17's read: the same rules as an FC03 of it.
+        if (const auto bad = map.check(Table::holding, rw->read_address, rw->read_count, false)) {
+            return bad;
+        }
+    }
     const std::optional<RequestSpan> span = request_span(request);
     if (!span) {
         return std::nullopt;  // FC07: listed, no data
@@ -167,6 +186,21 @@ std::optional<protocol::ExceptionCode> validate_request(const RegisterMap& map, 
         return bad;
     }
     if (!span->write) {
+        return std::nullopt;
+    }
+    if (std::holds_alternative<protocol::MaskWriteRegisterRequest>(request)) {
+        // FC16: the value it leaves depends on the register's current value, so only
+        // a plain 16-bit register that takes any value may be masked: not half of a
+        // 32-bit pair, not one with a range, a stop value or an auto reset; a
+        // protected one only with allow_protected, as every other write.
+        const RegisterDef* def = map.find(Table::holding, span->address);
+        if (def != nullptr && def->protect && !allow_protected) {
+            return protocol::ExceptionCode::illegal_function;
+        }
+        if (def == nullptr || def->width != 1 || def->min > 0 || def->max < 0xFFFF || def->stop_value ||
+            def->auto_reset) {
+            return protocol::ExceptionCode::illegal_data_value;
+        }
         return std::nullopt;
     }
     const std::vector<WrittenUnit> units = written_units(map, *span);

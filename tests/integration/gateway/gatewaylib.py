@@ -411,6 +411,15 @@ class CellTestCase(unittest.TestCase):
             f.write(config)
         self.start_gateway(launcher() if launcher else (), wait_ready)
 
+    def rewrite_config(self, old, new):
+        """Replaces the first `old` of the gateway's configuration file by `new` (for a
+        reload); fails when `old` is not there."""
+        with open(self.config_path, encoding="utf-8") as f:
+            text = f.read()
+        self.assertIn(old, text)
+        with open(self.config_path, "w", encoding="utf-8") as f:
+            f.write(text.replace(old, new, 1))
+
     def start_gateway(self, launcher=(), wait_ready=True):
         self.gateway = Process("fieldbridge", list(launcher) + [GATEWAY, "--config", self.config_path],
                                self.path("gateway.log"), env=environment())

@@ -70,13 +70,6 @@ class HitlessReload(gl.CellTestCase):
     def bus(self, name):
         return self.sim_stats()["buses"][name]
 
-    def rewrite(self, old, new):
-        with open(self.config_path, encoding="utf-8") as f:
-            text = f.read()
-        self.assertIn(old, text)
-        with open(self.config_path, "w", encoding="utf-8") as f:
-            f.write(text.replace(old, new, 1))
-
     def silence_window(self):
         """Requests and the longest idle time of line-b since the previous call (the
         simulator measures it on the emulated wire: end of a frame to the next request)."""
@@ -148,7 +141,7 @@ class HitlessReload(gl.CellTestCase):
         for round_number in range(ROUNDS):
             for expect, before, after in kinds:
                 old, new = (before, after) if round_number % 2 == 0 else (after, before)
-                self.rewrite(old, new)
+                self.rewrite_config(old, new)
                 rounds[expect].append(self.reload(expect))
                 self.more_reads(self.readers, 30)
         for reader in self.readers:

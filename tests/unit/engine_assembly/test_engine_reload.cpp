@@ -10,6 +10,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <asio/io_context.hpp>
@@ -176,9 +177,44 @@ TEST_CASE("a device whose profile settings changed is swapped on the open port")
     CHECK(cell.engine.find_unit(fieldbridge::core::UnitId{2}) == swapped);
     CHECK(cell.line("line-a").retired.size() == 1);
 
-    // The next reload that touches the line lets the drained agent go.
+    // The old agent's polls left the queue with it (nobody waits for them), so the
+    // next reload that touches the line lets the drained agent go.
+    CHECK(worker_a->scheduler().queued(stepper->config().index) == 0);
     const auto old_index = stepper->config().index;
     const auto third = replaced(next, "max_age: 200ms}", "max_age: 300ms}");
+    (void)cell.engine.apply(*config_of(third));
+    CHECK(cell.line("line-a").retired.empty());
+    CHECK_FALSE(worker_a->scheduler().has_device(old_index));
+}
+
+TEST_CASE("a swapped device's queued request still goes out and is answered, whatever reloads follow") {
+    Cell cell;
+    auto* worker_a = cell.line("line-a").worker.get();
+    auto* stepper = cell.engine.find_device("stepper");
+    // A client's read of the stepper, queued behind the line's polls (the port never
+    // answers: each transaction waits its response timeout).
+    std::optional<fieldbridge::protocol::Response> answer;
+    stepper->request(fieldbridge::protocol::ReadRegistersRequest{0x03, 0x0014, 2},
+                     [&answer](const fieldbridge::protocol::Response& response) { answer = response; });
+    const auto old_index = stepper->config().index;
+    const auto next = replaced(base_config, "{name: stepper, type: excd203mb, address: 2, unit_id: 2}",
+                               "{name: stepper, type: excd203mb, address: 2, unit_id: 2, allow_protected: true}");
+    (void)cell.engine.apply(*config_of(next));
+    // A storm: the reloads right after it keep the old agent while its request is open.
+    const auto third = replaced(next, "max_age: 200ms}", "max_age: 300ms}");
+    (void)cell.engine.apply(*config_of(third));
+    (void)cell.engine.apply(*config_of(next));
+    CHECK_FALSE(answer.has_value());
+    CHECK(cell.line("line-a").retired.size() == 1);
+    CHECK(worker_a->scheduler().has_device(old_index));
+    // It went to the line and was answered by what the line saw: no reply, 0x0B; never
+    // cancelled (0x0A) by a reload.
+    const auto until = std::chrono::steady_clock::now() + 5s;
+    while (!answer && std::chrono::steady_clock::now() < until) cell.io.run_for(10ms);
+    REQUIRE(answer.has_value());
+    const auto* refused = std::get_if<fieldbridge::protocol::ExceptionResponse>(&*answer);
+    REQUIRE(refused != nullptr);
+    CHECK(refused->code == fieldbridge::protocol::ExceptionCode::gateway_target_failed);
     (void)cell.engine.apply(*config_of(third));
     CHECK(cell.line("line-a").retired.empty());
     CHECK_FALSE(worker_a->scheduler().has_device(old_index));

@@ -58,8 +58,8 @@ TEST_CASE("generic: requests inside the blocks pass, others are refused locally"
     CHECK_FALSE(g.validate(fp::WriteSingleCoilRequest{3, true}, image));
     CHECK_FALSE(g.validate(fp::WriteMultipleCoilsRequest{0, std::vector<bool>(16, true)}, image));
     CHECK(g.validate(fp::ReadExceptionStatusRequest{}, image) == ExceptionCode::illegal_function);
-    CHECK(g.validate(fp::ReadWriteRegistersRequest{0, 1, 0, {1}}, image) == ExceptionCode::illegal_function);
     CHECK(g.validate(read_holding(0, 0), image) == ExceptionCode::illegal_data_value);
+    CHECK(g.validate(fp::OpaqueRequest{0x41, {}}, image) == ExceptionCode::illegal_function);
 
     const auto c = g.classify(write_single(0, 1));
     CHECK(c.write);
@@ -124,4 +124,73 @@ TEST_CASE("generic: block options that cannot work are refused with a reason") {
           std::string::npos);
     CHECK(error_of(blocks({{Table::input, 0, 2, milliseconds{100}, true}})).find("writable") != std::string::npos);
     CHECK(error_of(blocks({{Table::holding, 0, 2, milliseconds{0}, false}})).find("period") != std::string::npos);
+}
+
+TEST_CASE("generic: FC11 report server ID, FC16 mask write and FC17 read/write go through the block checks") {
+    const fe::GenericProfile g{blocks(plant)};
+    fe::RegisterImage image;
+    // FC11 carries no data; the device's answer is passed through as it came.
+    const fp::Request server_id = fp::OpaqueRequest{0x11, {}};
+    CHECK_FALSE(g.validate(server_id, image));
+    CHECK(g.validate(fp::OpaqueRequest{0x11, {0x00}}, image) == ExceptionCode::illegal_data_value);
+    CHECK_FALSE(g.classify(server_id).write);
+    const fp::Response id_reply = fp::OpaqueResponse{0x11, {0x03, 0x07, 0xFF, 0x4C}};
+    CHECK(g.respond(server_id, std::vector<fe::Reply>{modbus(id_reply)}, image) == id_reply);
+
+    // FC16: only a register of a writable holding block, as FC06.
+    const fp::Request mask = fp::MaskWriteRegisterRequest{0x0002, 0x00F2, 0x0025};
+    CHECK_FALSE(g.validate(mask, image));
+    CHECK(g.validate(fp::MaskWriteRegisterRequest{0x000A, 0, 1}, image) == ExceptionCode::illegal_data_address);
+    CHECK(g.validate(fp::MaskWriteRegisterRequest{0x0020, 0, 1}, image) == ExceptionCode::illegal_data_address);
+    const auto c = g.classify(mask);
+    CHECK(c.write);
+    CHECK_FALSE(c.idempotent);
+    image.update(Table::holding, 0x0002, std::vector<std::uint16_t>{0x0012}, t0());
+    const auto out = g.to_line(mask, image);
+    REQUIRE(out.size() == 1);
+    CHECK(pdu_hex(out[0]) == "16 00 02 00 F2 00 25");
+    const fe::Reply echo = modbus(fp::MaskWriteResponse{0x0002, 0x00F2, 0x0025});
+    CHECK(g.apply(out[0], echo, image, t0()).status == fe::ApplyStatus::applied);
+    // What it holds now depends on what it held: read from the device again.
+    CHECK(image.quality(Table::holding, 0x0002) == fe::Quality::stale);
+    CHECK(g.respond(mask, std::vector<fe::Reply>{echo}, image) == fp::Response{fp::MaskWriteResponse{2, 0xF2, 0x25}});
+
+    // FC17: the write as an FC10 of it, the read as an FC03 of it.
+    const fp::Request rw = fp::ReadWriteRegistersRequest{0x000A, 3, 0x0004, {0xAAAA, 0xBBBB}};
+    CHECK_FALSE(g.validate(rw, image));
+    CHECK(g.validate(fp::ReadWriteRegistersRequest{0x000A, 6, 0x0004, {1}}, image) ==
+          ExceptionCode::illegal_data_address);  // the read runs past the blocks
+    CHECK(g.validate(fp::ReadWriteRegistersRequest{0x0000, 1, 0x0009, {1, 2}}, image) ==
+          ExceptionCode::illegal_data_address);  // the write reaches the read-only 0x000A
+    CHECK(g.classify(rw).write);
+    const fe::Reply read_back = modbus(fp::ReadRegistersResponse{0x17, {0x000A, 0x000B, 0x000C}});
+    REQUIRE(g.to_line(rw, image).size() == 1);
+    CHECK(g.apply(fe::ModbusPayload{rw}, read_back, image, t0()).status == fe::ApplyStatus::applied);
+    CHECK(values_of(image, Table::holding, 0x0004, 2) == std::vector<std::uint16_t>{0xAAAA, 0xBBBB});
+    CHECK(values_of(image, Table::holding, 0x000A, 3) == std::vector<std::uint16_t>{0x000A, 0x000B, 0x000C});
+    CHECK(g.respond(rw, std::vector<fe::Reply>{read_back}, image) ==
+          fp::Response{fp::ReadRegistersResponse{0x17, {0x000A, 0x000B, 0x000C}}});
+}
+
+TEST_CASE("generic: FC16 only on a plain 16-bit register (checked through the shared map rules)") {
+    // A range, a stop value or half of a 32-bit pair: the value it would leave cannot be checked.
+    std::vector<fe::RegisterDef> defs(3);
+    defs[0].address = 0;
+    defs[0].access = fe::Access::read_write;
+    defs[1].address = 1;
+    defs[1].access = fe::Access::read_write;
+    defs[1].max = 100;
+    defs[2].address = 2;
+    defs[2].width = 2;
+    defs[2].access = fe::Access::read_write;
+    defs[2].max = 0xFFFFFFFF;
+    const fe::RegisterMap map{defs};
+    const std::vector<fieldbridge::core::FunctionCode> functions{fp::fn::mask_write_register};
+    CHECK_FALSE(fe::validate_request(map, fp::MaskWriteRegisterRequest{0, 0, 1}, functions, false, {}));
+    CHECK(fe::validate_request(map, fp::MaskWriteRegisterRequest{1, 0, 1}, functions, false, {}) ==
+          ExceptionCode::illegal_data_value);
+    CHECK(fe::validate_request(map, fp::MaskWriteRegisterRequest{2, 0, 1}, functions, false, {}) ==
+          ExceptionCode::illegal_data_address);  // half a pair: the map's own rule
+    CHECK(fe::validate_request(map, fp::WriteSingleRegisterRequest{0, 1}, functions, false, {}) ==
+          ExceptionCode::illegal_function);
 }

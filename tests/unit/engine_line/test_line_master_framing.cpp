@@ -202,16 +202,25 @@ TEST_CASE("framing: a Modbus exception reply is a valid reply (XEG 0x04 is deliv
           fp::ExceptionResponse{0x03, fp::ExceptionCode::server_device_failure});
 }
 
-TEST_CASE("framing: a well-framed reply that does not answer the request is a bad reply") {
+TEST_CASE("framing: a well-framed reply that does not answer the request is a bad reply, decided at once") {
     Sent s(write_tx(0, 2, 0x0601, 1));
-    // FC06 echoing another value: right address, function and CRC, wrong content.
+    // FC06 echoing another value: right address, function and CRC, wrong content. The
+    // device answered: the transaction ends now (0x04 northbound), not at the timeout.
     const Bytes wrong_echo = rtu(2, fp::encode_response(fp::WriteSingleResponse{0x06, 0x0601, 2}));
     s.master.on_bytes(wrong_echo, s.tx_end + 2ms);
     CHECK(s.master.counters().bad_replies == 1);
-    CHECK(s.master.state() == fe::MasterState::awaiting_reply);
-    const Bytes right = rtu(2, fp::encode_response(fp::WriteSingleResponse{0x06, 0x0601, 1}));
-    s.master.on_bytes(right, s.tx_end + 3ms);
-    CHECK(expect_finished(s.master, s.tx_end + 3ms).outcome.status == OutcomeStatus::ok);
+    CHECK(expect_finished(s.master, s.tx_end + 2ms).outcome.status == OutcomeStatus::bad_reply);
+    CHECK(s.master.counters().timeouts == 0);
+
+    // A read of one register (read_model) answered with two (framed by its own byte
+    // count, good CRC): the same, as soon as its last byte is in.
+    Sent read;
+    const Bytes two = rtu(2, Bytes{0x03, 0x04, 0x00, 0x01, 0x00, 0x02});
+    read.master.on_bytes(fp::ByteView(two).first(two.size() - 1), read.tx_end + 2ms);
+    CHECK(std::holds_alternative<fe::line_action::Wait>(read.master.next_action(read.tx_end + 2ms)));
+    read.master.on_bytes(fp::ByteView(two).last(1), read.tx_end + 2ms + 100us);
+    CHECK(expect_finished(read.master, read.tx_end + 2ms + 100us).outcome.status == OutcomeStatus::bad_reply);
+    CHECK(read.master.counters().bad_replies == 1);
 }
 
 TEST_CASE("framing: bytes after the reply, and a late reply, are garbage that pushes the silence") {

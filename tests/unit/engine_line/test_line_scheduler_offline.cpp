@@ -91,6 +91,26 @@ TEST_CASE("offline: a valid reply in between resets the count") {
     CHECK(f.health.events.empty());
 }
 
+TEST_CASE("offline: a reply that does not fit the request is an answer: it resets the count and brings a device back") {
+    Fixture f;
+    TimePoint now = t0;
+    for (const auto status : {OutcomeStatus::timeout, OutcomeStatus::timeout, OutcomeStatus::bad_reply,
+                              OutcomeStatus::timeout, OutcomeStatus::timeout}) {
+        f.poll(0, now);
+        f.run(0, now += 100ms, status);
+    }
+    CHECK(f.s.online(0));
+    f.poll(0, now);
+    f.run(0, now += 100ms, OutcomeStatus::timeout);
+    REQUIRE_FALSE(f.s.online(0));
+    // The probe is answered with a misfit: the device is there, back online; the read
+    // itself is not retried.
+    f.poll(0, now);
+    f.run(0, now += 2s, OutcomeStatus::bad_reply);
+    CHECK(f.s.online(0));
+    CHECK_FALSE(f.s.next(now).has_value());
+}
+
 TEST_CASE("offline: other outcomes neither count nor reset") {
     Fixture f;
     TimePoint now = t0;

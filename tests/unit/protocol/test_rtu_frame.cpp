@@ -212,11 +212,27 @@ TEST_CASE("rtu: wrong address, wrong function, bad CRC, unexpected byte count") 
     CHECK(describe_consumed(p::frame_rtu_response(fc04, 0x02, read_model)) == "malformed wrong_function 7");
     const Bytes exception_84 = p::encode_rtu(0x02, Bytes{0x84, 0x02});
     CHECK(describe_consumed(p::frame_rtu_response(exception_84, 0x02, read_model)) == "malformed wrong_function 5");
-    // Two registers where one was asked: the byte count gives it away at once.
+    // Two registers where one was asked: framed by its own byte count, a whole frame
+    // with a good CRC from the device asked (decode_response refuses it:
+    // unexpected_reply), so the line answers at once instead of waiting for a timeout.
     const Bytes two_regs = p::encode_rtu(0x02, Bytes{0x03, 0x04, 0x0A, 0x20, 0x00, 0x00});
-    CHECK(describe_consumed(p::frame_rtu_response(two_regs, 0x02, read_model)) == "malformed unexpected_reply 9");
-    CHECK(describe_consumed(p::frame_rtu_response(ByteView(two_regs).first(3), 0x02, read_model)) ==
-          "malformed unexpected_reply 3");
+    const auto framed_two = p::frame_rtu_response(two_regs, 0x02, read_model);
+    REQUIRE(framed_two.complete());
+    CHECK(framed_two.consumed == 9);
+    CHECK(p::decode_response(framed_two.value.pdu, read_model).error == p::DecodeError::unexpected_reply);
+    CHECK(p::frame_rtu_response(ByteView(two_regs).first(3), 0x02, read_model).need_more());
+    // The same byte count with a CRC that fails over that length: not a frame.
+    Bytes two_regs_bad = two_regs;
+    two_regs_bad.back() ^= 0x01;
+    const auto bad_crc = p::frame_rtu_response(two_regs_bad, 0x02, read_model);
+    CHECK(bad_crc.malformed());
+    CHECK(bad_crc.consumed == 9);
+    // One register where three were asked: framed, refused by the decoder.
+    const p::Request read3 = p::ReadRegistersRequest{0x03, 0x0A20, 3};
+    const Bytes none = p::encode_rtu(0x02, Bytes{0x03, 0x02, 0x00, 0x07});
+    const auto framed_short = p::frame_rtu_response(none, 0x02, read3);
+    REQUIRE(framed_short.complete());
+    CHECK(p::decode_response(framed_short.value.pdu, read3).error == p::DecodeError::unexpected_reply);
     // A request whose reply could not fit an ADU (200 registers).
     const p::Request too_many = p::ReadRegistersRequest{0x03, 0, 200};
     CHECK(describe_consumed(p::frame_rtu_response(Bytes{0x02, 0x03, 0x90}, 0x02, too_many)) == "malformed oversize 3");
