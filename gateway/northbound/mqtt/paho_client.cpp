@@ -12,6 +12,7 @@
 #include <asio/post.hpp>
 #include <mqtt/async_client.h>
 
+#include "core/error.hpp"
 #include "northbound/mqtt/inbound_gate.hpp"
 #include "northbound/mqtt/tls_advice.hpp"
 
@@ -172,8 +173,8 @@ PahoClient::PahoClient(asio::io_context& io, PahoOptions options)
         // No persistence and no offline buffer: state is republished on reconnect.
         core_->client_ = std::make_unique<::mqtt::async_client>(o.uri, o.client_id, ::mqtt::create_options(version));
     } catch (const std::exception& e) {
-        throw std::runtime_error("MQTT: cannot create a client for " + o.uri + ": " + e.what() +
-                                 "; check mqtt.uri in the configuration");
+        throw core::Error(std::string{"cannot create a client: "} + e.what(), "MQTT broker " + o.uri,
+                          "check mqtt.uri in the configuration");
     }
     Core* core = core_.get();
     core_->client_->set_connection_lost_handler([core](const std::string& cause) {
