@@ -1,6 +1,6 @@
 #pragma once
-// Driving an asio loop from a test until something happens, bounded: the MQTT tests
-// over the real engine / upstream wait for what the broker delivers this way.
+// What the MQTT tests over the real engine / upstream wait for: a JSON message the
+// broker delivers (run_until.hpp drives the loop).
 #include <chrono>
 #include <functional>
 #include <optional>
@@ -10,20 +10,11 @@
 #include <nlohmann/json.hpp>
 
 #include "broker_support.hpp"
+#include "run_until.hpp"
 
 namespace fbt {
 
-/// Runs @p io in 10 ms slices until @p done or @p limit; false on the limit.
-inline bool run_until(asio::io_context& io, const std::function<bool()>& done,
-                      std::chrono::milliseconds limit = std::chrono::seconds{15}) {
-    const auto until = std::chrono::steady_clock::now() + limit;
-    while (!done()) {
-        if (std::chrono::steady_clock::now() > until) return false;
-        io.restart();
-        io.run_for(std::chrono::milliseconds{10});
-    }
-    return true;
-}
+using fieldbridge::test_support::run_until;
 
 /// Runs @p io until @p observer has a JSON message on @p topic (from index @p from)
 /// that @p match accepts; nullopt when none came within run_until's limit.

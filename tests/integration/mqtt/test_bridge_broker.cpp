@@ -11,6 +11,7 @@
 
 #include "broker_support.hpp"
 #include "fake_source.hpp"
+#include "run_until.hpp"
 #include "northbound/mqtt/mqtt_bridge.hpp"
 #include "northbound/mqtt/paho_client.hpp"
 
@@ -48,16 +49,7 @@ std::unique_ptr<fm::Client> paho(asio::io_context& io, const Mosquitto& broker, 
     return std::make_unique<fm::PahoClient>(io, o);
 }
 
-/// Runs the loop until @p done or the limit; true when done.
-bool run_until(asio::io_context& io, const std::function<bool()>& done, std::chrono::milliseconds limit = wait_limit) {
-    const auto until = std::chrono::steady_clock::now() + limit;
-    while (!done()) {
-        if (std::chrono::steady_clock::now() > until) return false;
-        io.restart();
-        io.run_for(10ms);
-    }
-    return true;
-}
+using fieldbridge::test_support::run_until;
 
 /// Runs the loop until the observer got a message on @p topic matching @p match
 /// (from message index @p from on).
@@ -71,7 +63,7 @@ std::optional<Received> expect(asio::io_context& io, Observer& observer, const s
     run_until(io, [&] {
         found = observer.wait_for(topic, matcher, 0ms, from);
         return found.has_value();
-    });
+    }, wait_limit);
     return found;
 }
 
@@ -130,9 +122,18 @@ TEST_CASE("bridge + mosquitto: availability online, state retained and updated o
     CHECK((*state)["quality"] == "good");
     CHECK((*state)["raw"]["input"]["0x0300"] == 1000);
 
-    // Below the deadband: no new state; above: published.
+    // Below the deadband (0.05): no new state, though six min_intervals pass; above:
+    // published. Without the deadband 10.02 goes out within one min_interval (50 ms).
     std::size_t from = rig.observer->count();
+    const auto states_since = [&](std::size_t first) {
+        std::size_t n = 0;
+        const auto all = rig.observer->messages();
+        for (std::size_t i = first; i < all.size(); ++i) n += all[i].topic == "t1/gw/g1/state" ? 1 : 0;
+        return n;
+    };
     rig.source->set_position(10.02);
+    CHECK_FALSE(run_until(rig.io, [&] { return states_since(from) > 0; }, 300ms));
+    CHECK(states_since(from) == 0);
     rig.source->set_position(17.0);
     state = rig.expect_json("g1/state", [](const json& j) { return j["fields"]["position_mm"] == 17.0; }, from);
     REQUIRE(state);

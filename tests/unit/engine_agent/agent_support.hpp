@@ -24,6 +24,7 @@
 #include "engine/profiles/profile_factory.hpp"
 #include "protocol/modbus_pdu.hpp"
 #include "protocol/wtec_ascii_commands.hpp"
+#include "run_until.hpp"
 
 namespace fbt {
 
@@ -180,18 +181,8 @@ inline fe::Reply ascii_reply(const fe::Transaction& t, const fw::Reply& reply) {
 
 // ---- the loop --------------------------------------------------------------------
 
-/// Runs @p io until @p done() holds; false after @p timeout.
-template <typename Predicate>
-bool run_until(asio::io_context& io, Predicate done, std::chrono::milliseconds timeout = 3s) {
-    const auto end = Clock::now() + timeout;
-    while (!done()) {
-        if (Clock::now() >= end) return false;
-        io.run_one_for(5ms);
-    }
-    return true;
-}
-/// Runs the handlers due within @p duration (to show that nothing else happens).
-inline void run_for(asio::io_context& io, std::chrono::milliseconds duration) { io.run_for(duration); }
+using fieldbridge::test_support::run_for;
+using fieldbridge::test_support::run_until;
 
 // ---- an agent on the fake line ---------------------------------------------------
 

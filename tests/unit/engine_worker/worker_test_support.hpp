@@ -19,6 +19,7 @@
 #include "engine/line_worker.hpp"
 #include "protocol/modbus_pdu.hpp"
 #include "protocol/rtu_frame.hpp"
+#include "run_until.hpp"
 
 namespace worker_test {
 
@@ -30,26 +31,8 @@ using fe::Priority;
 using fe::Transaction;
 using fp::Bytes;
 
-/// Runs the loop until @p done() or @p limit passes; false on timeout.
-template <typename Predicate>
-bool run_until(asio::io_context& io, Predicate done, std::chrono::milliseconds limit = 3000ms) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (!done()) {
-        if (std::chrono::steady_clock::now() >= deadline) return false;
-        if (io.stopped()) io.restart();
-        io.run_one_for(5ms);
-    }
-    return true;
-}
-
-/// Runs the loop for @p duration (to show that something does NOT happen).
-inline void run_for(asio::io_context& io, std::chrono::milliseconds duration) {
-    const auto deadline = std::chrono::steady_clock::now() + duration;
-    while (std::chrono::steady_clock::now() < deadline) {
-        if (io.stopped()) io.restart();
-        io.run_one_for(2ms);
-    }
-}
+using fieldbridge::test_support::run_for;
+using fieldbridge::test_support::run_until;
 
 /// Counts on_done calls per tag and keeps the outcomes.
 class Recorder {

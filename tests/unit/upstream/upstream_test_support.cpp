@@ -20,23 +20,6 @@ std::uint16_t free_port() {
     return a.local_endpoint().port();
 }
 
-bool run_until(asio::io_context& io, const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-    const auto deadline = Clock::now() + timeout;
-    while (!done()) {
-        if (Clock::now() >= deadline) return false;
-        io.restart();
-        io.run_for(std::chrono::milliseconds{5});
-    }
-    return true;
-}
-
-void run_for(asio::io_context& io, std::chrono::milliseconds duration) {
-    const auto deadline = Clock::now() + duration;
-    while (Clock::now() < deadline) {
-        io.restart();
-        io.run_for(std::chrono::milliseconds{5});
-    }
-}
 
 fieldbridge::config::UpstreamConfig config_for(std::uint16_t port) {
     using std::chrono::milliseconds;

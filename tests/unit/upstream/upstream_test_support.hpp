@@ -16,6 +16,7 @@
 #include "engine/line_log.hpp"
 #include "northbound/unit_target.hpp"
 #include "protocol/bytes.hpp"
+#include "run_until.hpp"
 
 namespace fbtest {
 
@@ -24,12 +25,8 @@ using fieldbridge::protocol::Bytes;
 /// A loopback TCP port nobody listens on right now.
 [[nodiscard]] std::uint16_t free_port();
 
-/// Runs @p io until @p done or @p timeout; true when done.
-bool run_until(asio::io_context& io, const std::function<bool()>& done,
-               std::chrono::milliseconds timeout = std::chrono::seconds{10});
-
-/// Runs @p io for @p duration (lets timers and sockets work).
-void run_for(asio::io_context& io, std::chrono::milliseconds duration);
+using fieldbridge::test_support::run_for;
+using fieldbridge::test_support::run_until;
 
 /// An upstream config for 127.0.0.1:@p port with gateway unit 10 -> upstream unit 1,
 /// short timeouts for tests.
