@@ -199,12 +199,12 @@ lines:
                        port, metrics_port, cached_line, line_b, options.baud, direct_devices(options.shape));
 }
 
-std::uint64_t bus_counter(const integration::SimProcess& sim, const char* bus, const char* name) {
+std::uint64_t bus_counter(const test::SimProcess& sim, const char* bus, const char* name) {
     return sim.bus_counter(bus, name);
 }
 
 /// Parts 1 and 1b: cache-served reads from line-a's image.
-void run_cache(const Options& options, const integration::SimProcess& sim, const bench::DaemonProcess& daemon,
+void run_cache(const Options& options, const test::SimProcess& sim, const bench::DaemonProcess& daemon,
                std::uint16_t port) {
     const double seconds = options.seconds;
     // Let the polls fill line-a's image, then measure an idle window: the polls alone.
@@ -305,7 +305,7 @@ int run(const Options& options) {
     const LoadShape& shape = options.shape;
     const bench::LineLimit limit = bench::line_limit(shape, options.baud, turnaround);
     const std::string baud = std::to_string(options.baud);
-    integration::SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-b:" + shape.sim_devices(),
+    test::SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2", "--bus", "{dir}/line-b:" + shape.sim_devices(),
                                  "--bus", "{dir}/line-floor:" + shape.sim_devices(), "--wire-time", "--baud", baud,
                                  "--turnaround", "1ms"});
     const std::string label = fmt::format("{} at {} bit/s", shape.name(), options.baud);

@@ -15,6 +15,7 @@ namespace {
 
 using engine::Priority;
 using engine::Table;
+using test::SimProcess;
 
 TEST_CASE("engine.priority: a write overtakes the on-demand reads queued before it") {
     SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2,excd203mb@3", "--wire-time", "--baud", "115200"});

@@ -16,6 +16,7 @@ namespace {
 
 using engine::OutcomeStatus;
 using engine::Priority;
+using test::SimProcess;
 
 constexpr std::array<const char*, 3> live{"xeg", "excd", "ascii"};
 constexpr auto warm_up = seconds{1};

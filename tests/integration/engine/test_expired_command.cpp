@@ -15,6 +15,7 @@ namespace {
 using engine::OutcomeStatus;
 using engine::Priority;
 using engine::Table;
+using test::SimProcess;
 
 TEST_CASE("engine.expiry: a command past its deadline is answered 0x0B and never sent") {
     SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2,excd203mb@3,excd203mb@4", "--wire-time", "--baud", "115200"});

@@ -18,6 +18,7 @@ namespace fieldbridge::integration {
 namespace {
 
 using engine::Table;
+using test::SimProcess;
 
 TEST_CASE("engine.late_loop: a reply in the buffer wins over its timeout after a slow handler") {
     SimProcess sim({"--bus", "{dir}/line-a:excd203mb@3", "--wire-time", "--baud", "115200"});

@@ -16,6 +16,7 @@ namespace {
 using engine::OutcomeStatus;
 using engine::Priority;
 using engine::Table;
+using test::SimProcess;
 
 constexpr std::array<const char*, 3> polled{"xeg", "excd", "ascii"};
 

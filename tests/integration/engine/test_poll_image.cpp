@@ -11,6 +11,7 @@ namespace fieldbridge::integration {
 namespace {
 
 using engine::Table;
+using test::SimProcess;
 
 std::string cell_yaml(const SimProcess& sim) {
     return fmt::format(R"(

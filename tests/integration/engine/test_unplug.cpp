@@ -15,6 +15,7 @@ using engine::OutcomeStatus;
 using engine::Priority;
 using engine::Quality;
 using engine::Table;
+using test::SimProcess;
 
 TEST_CASE("engine.unplug: the line goes down with its port and comes back with it") {
     SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2,excd203mb@3", "--bus", "{dir}/line-b:wtec-rtu@1",

@@ -14,6 +14,7 @@ namespace {
 using engine::OutcomeStatus;
 using engine::Priority;
 using engine::Table;
+using test::SimProcess;
 
 TEST_CASE("engine.write_retry: a write that times out is sent once and a read is retried") {
     SimProcess sim({"--bus", "{dir}/line-a:hiwin-xeg@2,excd203mb@3", "--wire-time", "--baud", "115200"});

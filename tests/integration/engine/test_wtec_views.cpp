@@ -16,6 +16,7 @@ namespace fieldbridge::integration {
 namespace {
 
 using engine::Table;
+using test::SimProcess;
 
 /// The readable registers of the uniform map, except 0x0302 (W only in the ASCII
 /// view) and 0x0303 (each device's own address). Force 0x0103 is the `N` max (grip)

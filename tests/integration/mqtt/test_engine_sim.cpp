@@ -5,15 +5,6 @@
 // publishes offline.
 #include <doctest/doctest.h>
 
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
@@ -30,12 +21,11 @@
 #include "engine/engine.hpp"
 #include "temp_dir.hpp"
 
-extern char** environ;
-
 namespace {
 
 using namespace fbt;
 using namespace std::chrono_literals;
+using fieldbridge::test::SimProcess;
 using nlohmann::json;
 namespace fe = fieldbridge::engine;
 namespace fa = fieldbridge::app;
@@ -50,9 +40,9 @@ TEST_CASE("MQTT component + engine + simulated XEG + mosquitto") {
     Mosquitto broker(free_port());
     broker.start();
     {
-        Sim sim(dir, {"--bus", dir + "/line-a:hiwin-xeg@1"});
+        SimProcess sim({"--log-level", "warn", "--bus", "{dir}/line-a:hiwin-xeg@1"});
         std::ofstream(dir + "/config.yaml") << "gateway:\n  id: simtest\n"
-                                            << "lines:\n  - name: line-a\n    port: " << dir << "/line-a\n"
+                                            << "lines:\n  - name: line-a\n    port: " << sim.path("line-a") << "\n"
                                             << "    devices:\n      - name: g1\n        type: hiwin-xeg\n"
                                             << "        address: 1\n        unit_id: 1\n"
                                             << "mqtt:\n  uri: " << broker.uri() << "\n  prefix: sim/gw\n"

@@ -17,6 +17,7 @@
 namespace {
 
 using namespace fbt;
+using fieldbridge::test::SimProcess;
 using nlohmann::json;
 namespace fm = fieldbridge::northbound::mqtt;
 namespace fu = fieldbridge::northbound::upstream;
@@ -30,7 +31,7 @@ TEST_CASE("R6 units on MQTT: decoded state, alarm raise / clear, commands throug
     broker.start();
     {
         const int r6_port = free_port();
-        Sim sim(dir, {"--r6", "127.0.0.1:" + std::to_string(r6_port)});
+        SimProcess sim({"--log-level", "warn", "--r6", "127.0.0.1:" + std::to_string(r6_port)});
         asio::io_context io;
         fieldbridge::config::UpstreamConfig upstream;
         upstream.name = "r6";

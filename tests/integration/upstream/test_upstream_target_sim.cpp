@@ -4,16 +4,18 @@
 #include <doctest/doctest.h>
 
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "northbound/upstream/upstream_target.hpp"
-#include "r6_sim_process.hpp"
+#include "sim_process.hpp"
 #include "upstream_test_support.hpp"
 
 using namespace fieldbridge;
 using namespace fieldbridge::northbound;
 using namespace fieldbridge::northbound::upstream;
 using namespace fbtest;
+using fieldbridge::test::SimProcess;
 using std::chrono::milliseconds;
 
 namespace {
@@ -64,12 +66,13 @@ Bytes ask(asio::io_context& io, UpstreamTarget& target, const Bytes& pdu, std::u
 
 struct Running {
     asio::io_context io;
-    SimProcess sim{free_port()};
+    std::uint16_t port = free_port();
+    SimProcess sim{{"--r6", "127.0.0.1:" + std::to_string(port)}};
     CapturedLog log;
     std::unique_ptr<UpstreamTarget> target;
 
     explicit Running(UpstreamTuning tuning = {}) {
-        target = std::make_unique<UpstreamTarget>(io, config_for(sim.port()), log.sink(), tuning);
+        target = std::make_unique<UpstreamTarget>(io, config_for(port), log.sink(), tuning);
         target->start();
         REQUIRE(run_until(io, [&] { return target->link_state() == LinkState::up; }));
     }
@@ -133,7 +136,7 @@ TEST_CASE("two clients reading counters concurrently each get their own counter"
 TEST_CASE("the simulator dies and comes back: 0x0A / 0x0B meanwhile, then it works again") {
     Running r;
     CHECK(ask(r.io, *r.target, hex("03 08 db 00 01")) == hex("03 02 00 06"));
-    r.sim.kill();
+    r.sim.terminate();
     // Whatever was out when it died is 0x0B, what arrives while it is down is 0x0A.
     const Bytes during = ask(r.io, *r.target, hex("03 08 db 00 01"));
     CHECK((during == hex("83 0A") || during == hex("83 0B")));
@@ -198,7 +201,7 @@ TEST_CASE("state polling decodes mode, alarm, motion, axes, world and cycle time
     REQUIRE(image != nullptr);
     CHECK(image->quality(engine::Table::holding, 0x09A6) == engine::Quality::good);
     const std::size_t before = reports.size();
-    r.sim.kill();
+    r.sim.terminate();
     REQUIRE(run_until(r.io, [&] { return !r.target->state(core::UnitId{10})->online; }));
     CHECK(reports.size() > before);
     CHECK_FALSE(reports.back().online);

@@ -1,7 +1,7 @@
 #pragma once
 // Test support for the R6 pass-through: an in-process scriptable Modbus TCP server,
 // bounded loop running, answer capture. The fieldbridge-sim R6 child process:
-// tests/integration/upstream/r6_sim_process.hpp.
+// tests/support/sim_process.hpp.
 #include <chrono>
 #include <cstdint>
 #include <functional>
