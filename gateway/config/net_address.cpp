@@ -139,6 +139,46 @@ Parsed<ListenAddress> parse_listen_address(std::string_view text) {
     return Result::ok(ListenAddress{std::string(host), *port_number});
 }
 
+std::string TcpEndpoint::to_string() const {
+    const bool v6 = host.find(':') != std::string::npos;
+    return (v6 ? "[" + host + "]" : host) + ":" + std::to_string(port);
+}
+
+bool is_tcp_port(std::string_view port) noexcept { return port.starts_with(tcp_port_scheme); }
+
+Parsed<TcpEndpoint> parse_tcp_port(std::string_view text) {
+    using Result = Parsed<TcpEndpoint>;
+    const std::string expected =
+        "expected tcp://HOST:PORT, e.g. tcp://192.168.1.20:4001, tcp://[fd00::7]:4001 or tcp://nport-3:4001";
+    if (!is_tcp_port(text)) return Result::fail("'" + std::string(text) + "' does not start with tcp://; " + expected);
+    const std::string_view rest = text.substr(tcp_port_scheme.size());
+    std::string_view host;
+    std::string_view port;
+    if (!rest.empty() && rest.front() == '[') {
+        const auto close = rest.find(']');
+        if (close == std::string_view::npos || close + 1 >= rest.size() || rest[close + 1] != ':') {
+            return Result::fail("'" + std::string(text) + "' has no port after the IPv6 address; " + expected);
+        }
+        host = rest.substr(1, close - 1);
+        port = rest.substr(close + 2);
+        if (!parse_ipv6(host)) return Result::fail("'" + std::string(host) + "' is not an IPv6 address; " + expected);
+    } else {
+        const auto colon = rest.rfind(':');
+        if (colon == std::string_view::npos) return Result::fail("'" + std::string(text) + "' has no port; " + expected);
+        host = rest.substr(0, colon);
+        port = rest.substr(colon + 1);
+        if (host.find(':') != std::string_view::npos) {
+            return Result::fail("'" + std::string(text) + "': an IPv6 address needs brackets; " + expected);
+        }
+        if (!is_valid_host(host)) {
+            return Result::fail("'" + std::string(host) + "' is not a host name or an IPv4 address; " + expected);
+        }
+    }
+    const auto port_number = parse_port(port);
+    if (!port_number) return Result::fail("'" + std::string(port) + "' is not a port; expected 1..65535");
+    return Result::ok(TcpEndpoint{std::string(host), *port_number});
+}
+
 bool is_valid_host(std::string_view host) {
     if (parse_ip_address(host)) {
         return true;

@@ -125,7 +125,17 @@ Duration LineScheduler::poll_age(const Transaction& transaction) const noexcept 
 }
 
 bool LineScheduler::eligible(const Device& device, TimePoint now) const noexcept {
-    return device.online || now >= device.probe_due;
+    return (device.online || now >= device.probe_due) && now >= device.paced_until;
+}
+
+TimePoint LineScheduler::ready_at(const Device& device) noexcept {
+    return device.online ? device.paced_until : std::max(device.probe_due, device.paced_until);
+}
+
+void LineScheduler::line_opened(TimePoint now) {
+    for (auto& [index, device] : devices_) {
+        device.paced_until = std::max(device.paced_until, now + device.limits.first_request_delay);
+    }
 }
 
 LineScheduler::Rank LineScheduler::rank(const Device& device, const Entry& entry,
@@ -355,6 +365,7 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
         return;
     }
     const DeviceIndex index = transaction.device;
+    if (transaction.attempts > 0) device->paced_until = now + device->limits.request_gap;
     if (outcome.status == OutcomeStatus::ok) {
         device->consecutive_timeouts = 0;
         if (const auto* response = std::get_if<protocol::Response>(&outcome.reply);
@@ -396,7 +407,7 @@ std::optional<TimePoint> LineScheduler::next_wakeup(TimePoint now) const {
     for (const auto& [index, device] : devices_) {
         if (device.queue.empty()) continue;
         if (eligible(device, now)) return now;
-        consider(device.probe_due);
+        consider(ready_at(device));
         for (const Entry& entry : device.queue) {
             if (entry.transaction.deadline) consider(*entry.transaction.deadline);
         }
