@@ -252,7 +252,7 @@ struct LineConfig {
     static constexpr Range<milliseconds> connect_timeout_range{milliseconds{10}, std::chrono::minutes{1}};
     /// tcp:// ports only: the wait before connecting again after a failure, doubling
     /// up to max (serial ports reopen on offline_backoff).
-    Backoff reconnect_backoff{milliseconds{250}, seconds{1}};
+    Backoff reconnect_backoff{milliseconds{250}, milliseconds{500}};
     unsigned read_retries = 1;  ///< writes are never retried (spec section 3 rule 6)
     static constexpr Range<std::int64_t> read_retries_range{0, 5};
     unsigned offline_after = 3;  ///< consecutive timeouts

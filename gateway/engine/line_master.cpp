@@ -320,6 +320,19 @@ void LineMaster::scan(TimePoint now) {
             continue;
         }
         counters_.garbage_bytes += result.skipped;
+        if (config_.stream && result.consumed < rx_.size()) {
+            // A TCP line: more bytes came after a whole reply. The device answers once
+            // per request, so the earlier frame answered an earlier request (held by
+            // the device server and sent with the new one): the newest frame is the
+            // answer. Dropped, never matched; the scan goes on with what follows.
+            counters_.garbage_bytes += result.consumed - result.skipped;
+            if (log_.enabled(LogLevel::debug)) {
+                log_(LogLevel::debug, describe() + ": dropped a whole reply followed by more bytes in the same "
+                                                   "segment (a late reply to an earlier request)");
+            }
+            rx_.erase(rx_.begin(), rx_.begin() + static_cast<std::ptrdiff_t>(result.consumed));
+            continue;
+        }
         // Bytes after the reply in the same read belong to nothing we asked for.
         counters_.garbage_bytes += rx_.size() - std::min(result.consumed, rx_.size());
         rx_.clear();

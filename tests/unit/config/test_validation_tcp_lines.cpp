@@ -53,7 +53,7 @@ TEST_CASE("tcp ports: IPv4, IPv6 in brackets and host names are read into the li
     // The defaults: the frame gap as byte_timeout's, the upstreams' kind of back-off.
     CHECK(named->lines[0].tcp_frame_gap == std::chrono::milliseconds{5});
     CHECK(named->lines[0].connect_timeout == std::chrono::seconds{2});
-    CHECK(named->lines[0].reconnect_backoff.max == std::chrono::seconds{1});
+    CHECK(named->lines[0].reconnect_backoff.max == std::chrono::milliseconds{500});
     const auto serial = load_ok(line_on("/dev/ttyS0"));
     CHECK_FALSE(serial->lines[0].tcp.has_value());
 }

@@ -54,11 +54,31 @@ TEST_CASE("stream: a partial reply is given up after the frame gap") {
     CHECK(s.master.counters().garbage_bytes == 3);
 }
 
-TEST_CASE("stream: two replies in one segment: the first is the answer, the rest is not matched to anything") {
+TEST_CASE("stream: two replies in one segment: the newest is the answer, the older one is a late reply") {
     StreamSent s;
-    s.master.on_bytes(concat({read_model_reply, read_model_reply}), s.tx_end + 1ms);
-    CHECK(expect_finished(s.master, s.tx_end + 1ms).outcome.status == OutcomeStatus::ok);
-    CHECK(s.master.counters().garbage_bytes == read_model_reply.size());
+    // The device server held the reply to an earlier read of the same register (it
+    // timed out) and sends it with this one's.
+    const Bytes stale = read_reply(2, {0x0BAD}, fp::fc::read_holding_registers);
+    s.master.on_bytes(concat({stale, read_model_reply}), s.tx_end + 1ms);
+    auto done = expect_finished(s.master, s.tx_end + 1ms);
+    REQUIRE(done.outcome.status == OutcomeStatus::ok);
+    const auto& reply = std::get<fp::Response>(done.outcome.reply);
+    CHECK(std::get<fp::ReadRegistersResponse>(reply).values == std::vector<std::uint16_t>{0x0A20});
+    CHECK(s.master.counters().garbage_bytes == stale.size());
+}
+
+TEST_CASE("stream: a whole reply followed by the start of another waits for the newer one") {
+    StreamSent s;
+    const Bytes stale = read_reply(2, {0x0BAD}, fp::fc::read_holding_registers);
+    const Bytes head(read_model_reply.begin(), read_model_reply.begin() + 2);
+    const Bytes tail(read_model_reply.begin() + 2, read_model_reply.end());
+    s.master.on_bytes(concat({stale, head}), s.tx_end + 1ms);
+    CHECK(s.master.state() == fe::MasterState::awaiting_reply);
+    s.master.on_bytes(tail, s.tx_end + 2ms);
+    auto done = expect_finished(s.master, s.tx_end + 2ms);
+    REQUIRE(done.outcome.status == OutcomeStatus::ok);
+    CHECK(std::get<fp::ReadRegistersResponse>(std::get<fp::Response>(done.outcome.reply)).values ==
+          std::vector<std::uint16_t>{0x0A20});
 }
 
 TEST_CASE("stream: bytes before the request can have crossed the far side's line are a late reply, dropped") {
