@@ -66,7 +66,8 @@ void TcpStreamPort::resolve() {
     addrinfo hints{};
     hints.ai_family = AF_UNSPEC;
     hints.ai_socktype = SOCK_STREAM;
-    hints.ai_flags = AI_NUMERICSERV | AI_ADDRCONFIG;
+    // No AI_ADDRCONFIG: it drops IPv4 on a box whose only IPv4 address is loopback.
+    hints.ai_flags = AI_NUMERICSERV;
     addrinfo* found = nullptr;
     const std::string service = std::to_string(settings_.tcp->port);
     const int rc = ::getaddrinfo(settings_.tcp->host.c_str(), service.c_str(), &hints, &found);

@@ -166,25 +166,25 @@ class DeviceServerCell(gatewaylib.CellTestCase):
 
     # -- replies that are not the answer -------------------------------------------------
 
-    def test_a_late_reply_is_never_matched_to_the_next_request(self):
+    def check_held_reply_not_matched(self, mode):
+        """The meter's reply to a read of register 0 is held by the device server
+        (`mode`) past its timeout; the next read (same device, function and length) of
+        register 10 gets its own value, never the held one."""
         self.start_servers_and_gateway()
         self.set_meter(0, 111)
         self.set_meter(10, 222)
-        # The reply to the read of register 0 is held past its timeout and arrives just
-        # after the next request (same device, function and length) was written.
-        self.server_m.set_mode("late")
+        self.server_m.set_mode(mode)
         self.assert_exception(self.client_.read_holding_registers(0, 1, slave=METER), GATEWAY_TIMEOUT)
         self.assertEqual(self.meter(10), 222)
         self.assertEqual(self.meter(0), 111)
 
+    def test_a_late_reply_is_never_matched_to_the_next_request(self):
+        # It arrives just after the next request was written.
+        self.check_held_reply_not_matched("late")
+
     def test_two_replies_in_one_segment_the_newest_answers(self):
-        self.start_servers_and_gateway()
-        self.set_meter(0, 111)
-        self.set_meter(10, 222)
-        self.server_m.set_mode("merge")
-        self.assert_exception(self.client_.read_holding_registers(0, 1, slave=METER), GATEWAY_TIMEOUT)
-        self.assertEqual(self.meter(10), 222)
-        self.assertEqual(self.meter(0), 111)
+        # It arrives in one segment with the next request's reply.
+        self.check_held_reply_not_matched("merge")
 
     # -- the connection's life -----------------------------------------------------------
 

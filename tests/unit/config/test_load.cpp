@@ -94,7 +94,7 @@ TEST_CASE("the demo configuration describes the demo cell") {
     CHECK(config->gateway.id == "demo");
     REQUIRE(config->modbus_tcp.listen.size() == 1);
     CHECK(config->modbus_tcp.listen[0].to_string() == "127.0.0.1:1502");
-    REQUIRE(config->lines.size() == 3);
+    REQUIRE(config->lines.size() == 2);
 
     const auto& a = config->lines[0];
     CHECK(a.name == "line-a");
