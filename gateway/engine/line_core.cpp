@@ -185,6 +185,7 @@ void LineCore::on(TimePoint now, line_event::Opened& event, LineStep& step) {
         log_(LogLevel::info, "line " + config_.name + ": " + port_path_ + " open, " + event.detail);
     }
     port_ = PortState::up;
+    quiet_ = RepeatedFailure{};
     open_attempts_ = 0;
     reopen_delay_ = config_.reopen_initial;
     step.watch_readable = true;
@@ -204,11 +205,27 @@ void LineCore::on(TimePoint now, line_event::OpenFailed& event, LineStep& step) 
         step.line_up = false;
     } else {
         reopen_delay_ = std::min(reopen_delay_ * 2, config_.reopen_max);
-        log_(LogLevel::warning, "line " + config_.name + ": reopening " + port_path_ + " failed (attempt " +
-                                    std::to_string(open_attempts_) + "): " + event.what + "; retrying in " +
-                                    duration_text(reopen_delay_));
+        log_reopen_failure(now, event.what);
     }
     schedule_reopen(now, step);
+}
+
+void LineCore::log_reopen_failure(TimePoint now, const std::string& what) {
+    // A device server switched off for an hour is thousands of attempts at a short
+    // back-off: once the back-off is at its maximum, a failure like the last one
+    // logged (also at the maximum) is logged at most once a minute, with a count.
+    const bool at_max = reopen_delay_ == config_.reopen_max;
+    if (at_max && quiet_.at_max && what == quiet_.what && now - quiet_.logged_at < repeat_log_interval) {
+        ++quiet_.suppressed;
+        return;
+    }
+    const std::string also = quiet_.suppressed == 0 ? std::string{}
+                                                    : " (" + std::to_string(quiet_.suppressed) +
+                                                          " more failures like it since the last such line)";
+    log_(LogLevel::warning, "line " + config_.name + ": reopening " + port_path_ + " failed (attempt " +
+                                std::to_string(open_attempts_) + "): " + what + "; retrying in " +
+                                duration_text(reopen_delay_) + also);
+    quiet_ = RepeatedFailure{what, now, at_max, 0};
 }
 
 void LineCore::on(TimePoint, line_event::ReopenDue&, LineStep& step) {

@@ -227,6 +227,7 @@ private:
     /// Opened / OpenFailed: the answer to open, or the end of a pending open.
     [[nodiscard]] bool open_answered(const char* event);
     [[nodiscard]] const char* cable_advice() const noexcept;
+    void log_reopen_failure(TimePoint now, const std::string& what);
     /// False for a stale answer after Stop; throws for an answer nobody asked for.
     [[nodiscard]] bool answered(LineNext first, LineNext second, const char* event);
     /// Throws std::logic_error when the shell owes an answer (a reactor event arrived
@@ -254,6 +255,15 @@ private:
     PortState port_ = PortState::idle;
     LineNext asked_ = LineNext::none;  ///< the question the shell is answering
     bool opening_ = false;  ///< OpenPending: the shell reports the open's end later
+    /// The last reopen failure logged (log_reopen_failure).
+    struct RepeatedFailure {
+        std::string what;
+        TimePoint logged_at{};
+        bool at_max = false;  ///< the back-off was at its maximum then
+        unsigned suppressed = 0;
+    };
+    static constexpr Duration repeat_log_interval = std::chrono::minutes{1};
+    RepeatedFailure quiet_;
     Duration reopen_delay_;
     unsigned open_attempts_ = 0;  ///< since the line went down (or since start)
     std::uint64_t reopens_ = 0;

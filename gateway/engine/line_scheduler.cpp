@@ -364,8 +364,9 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
         complete(std::move(transaction), outcome);
         return;
     }
-    const DeviceIndex index = transaction.device;
+    // Pacing counts from the end of the device's last transaction on the wire.
     if (transaction.attempts > 0) device->paced_until = now + device->limits.request_gap;
+    const DeviceIndex index = transaction.device;
     if (outcome.status == OutcomeStatus::ok) {
         device->consecutive_timeouts = 0;
         if (const auto* response = std::get_if<protocol::Response>(&outcome.reply);

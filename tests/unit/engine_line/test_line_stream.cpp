@@ -4,6 +4,8 @@
 // request_gap); the core waits for a connect that only began (OpenPending).
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 #include "line_core_fake.hpp"
 #include "line_test_support.hpp"
 
@@ -154,6 +156,26 @@ TEST_CASE("line core: a connect that fails later goes down and is retried on the
     line.advance_to(t0 + 100ms);
     CHECK(line.core.line_up());
     CHECK(line.core.reopens() == 1);
+}
+
+TEST_CASE("line core: at the maximum back-off a repeated failure is logged once a minute, with a count") {
+    FakeLine line;  // reopen back-off 100 ms doubling to 350 ms
+    line.open_failure = "tcp://10.0.0.7:4001: cannot connect to 10.0.0.7:4001 (Connection refused)";
+    line.start();
+    const auto reopen_lines = [&] {
+        return std::count_if(line.logs.begin(), line.logs.end(), [](const auto& entry) {
+            return entry.first == fe::LogLevel::warning && entry.second.find("reopening") != std::string::npos;
+        });
+    };
+    line.advance_to(t0 + 30s);  // about 85 attempts
+    CHECK(reopen_lines() == 2);  // 200 ms, then the first at the maximum (350 ms)
+    line.advance_to(t0 + 62s);
+    CHECK(reopen_lines() == 3);
+    CHECK(line.logged(fe::LogLevel::warning, "more failures like it since the last such line)"));
+    // Another failure is logged at once.
+    line.open_failure = "tcp://10.0.0.7:4001: no answer within 2000 ms (connect_timeout)";
+    line.advance(400ms);
+    CHECK(reopen_lines() == 4);
 }
 
 TEST_CASE("line core: Stop during a connect; the connect's late end is ignored") {
