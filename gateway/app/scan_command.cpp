@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <memory>
 #include <ostream>
 #include <string_view>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "config/config.hpp"
 #include "daemon/exit_codes.hpp"
 #include "engine/posix_serial_port.hpp"
+#include "engine/tcp_stream_port.hpp"
 #include "scan/line_link.hpp"
 #include "scan/line_scanner.hpp"
 #include "scan/scan_report.hpp"
@@ -23,6 +25,8 @@ namespace {
 /// The widest device address range: EXCD203MB takes 1-254 (seed 002 section 5).
 constexpr unsigned max_scan_address = 254;
 constexpr unsigned max_timeout_ms = 10000;
+/// A device server on the cell's network answers a connect within milliseconds.
+constexpr std::chrono::milliseconds scan_connect_timeout{2000};
 
 [[nodiscard]] engine::LogSink log_to(std::ostream& err, std::optional<config::LogLevel> level) {
     engine::LogSink sink;
@@ -46,6 +50,9 @@ constexpr unsigned max_timeout_ms = 10000;
     // 3.5 characters where that is longer (below 9600 bit/s).
     const engine::LineTiming wire(t.format(), t.inter_frame);
     t.byte_timeout = std::max<engine::Duration>(std::chrono::milliseconds{5}, wire.t3_5());
+    // Through a serial device server: the gateway's tcp_frame_gap default, the same figure.
+    t.stream = config::is_tcp_port(o.port);
+    t.frame_gap = t.byte_timeout;
     return t;
 }
 
@@ -63,8 +70,10 @@ std::string ScanCommand::description() const {
 }
 
 void ScanCommand::define(CLI::App& command) {
-    command.add_option("-p,--port", options_.port, "Serial port to scan, e.g. /dev/ttyUSB0")
-        ->type_name("DEV")
+    command
+        .add_option("-p,--port", options_.port,
+                    "Serial port to scan, e.g. /dev/ttyUSB0, or tcp://HOST:PORT of a serial device server")
+        ->type_name("DEV|tcp://HOST:PORT")
         ->required();
     std::vector<std::uint32_t> bauds(config::LineConfig::standard_bauds.begin(),
                                      config::LineConfig::standard_bauds.end());
@@ -111,10 +120,28 @@ int ScanCommand::run(std::optional<config::LogLevel> log_level) {
     settings.parity = options_.parity;
     settings.stop_bits = options_.stop_bits;
     settings.rs485 = options_.rs485;
+    if (config::is_tcp_port(options_.port)) {
+        const auto endpoint = config::parse_tcp_port(options_.port);
+        if (!endpoint) {
+            err_ << "fieldbridge scan: --port " << endpoint.error << '\n';
+            return daemon::exit_usage;
+        }
+        if (options_.rs485 || options_.local_echo) {
+            err_ << "fieldbridge scan: " << (options_.rs485 ? "--rs485" : "--local-echo")
+                 << " does not apply to a tcp:// port: the serial device server drives the line; leave it out\n";
+            return daemon::exit_usage;
+        }
+        settings.tcp = engine::StreamEndpoint{endpoint.value->host, endpoint.value->port, scan_connect_timeout};
+    }
 
-    engine::PosixSerialPort port(settings);
+    std::unique_ptr<engine::SerialPort> port;
+    if (settings.tcp) {
+        port = std::make_unique<engine::TcpStreamPort>(settings, engine::ConnectWait::block);
+    } else {
+        port = std::make_unique<engine::PosixSerialPort>(settings);
+    }
     try {
-        port.open();
+        port->open();
     } catch (const engine::SerialPortError& error) {
         err_ << "fieldbridge scan: " << error.what()
              << ". The scan needs the port to itself: stop a fieldbridge gateway (or any other program) using it.\n";
@@ -125,7 +152,7 @@ int ScanCommand::run(std::optional<config::LogLevel> log_level) {
          << options_.first << "-" << options_.last << ", timeout " << options_.timeout_ms << " ms\n";
     scan::ScanResult result;
     try {
-        scan::LineLink link(port, timing_of(options_), log_to(err_, log_level));
+        scan::LineLink link(*port, timing_of(options_), log_to(err_, log_level));
         scan::LineScanner scanner(
             link, scan::ScanRange{static_cast<std::uint8_t>(options_.first), static_cast<std::uint8_t>(options_.last)},
             [this](const std::string& text) { err_ << "fieldbridge scan: " << text << '\n'; });

@@ -80,6 +80,8 @@ void set(T& target, const Field<T>& field) {
     set(device.command_ttl, raw.command_ttl);
     set(device.delay_before_command, raw.delay_before_command);
     device.queue_limit = narrow<std::size_t>(raw.queue_limit, device.queue_limit);
+    set(device.request_gap, raw.request_gap);
+    set(device.first_request_delay, raw.first_request_delay);
     set(device.poll.fast, raw.poll.fast);
     set(device.poll.slow, raw.poll.slow);
     set(device.poll.motion, raw.poll.motion);
@@ -105,6 +107,7 @@ void set(T& target, const Field<T>& field) {
     LineConfig line = framing_of(raw);  // name-less framing with defaults; validated values are in range
     line.name = *raw.name;
     line.port = *raw.port;
+    if (is_tcp_port(line.port)) line.tcp = parse_tcp_port(line.port).value;  // validated
     set(line.rs485.enabled, raw.rs485.enabled);
     set(line.rs485.rts_on_send, raw.rs485.rts_on_send);
     set(line.rs485.rts_after_send, raw.rs485.rts_after_send);
@@ -115,7 +118,11 @@ void set(T& target, const Field<T>& field) {
     line.byte_timeout = raw.byte_timeout.value_or(default_byte_timeout(line));
     set(line.turnaround, raw.turnaround);
     set(line.broadcast_delay, raw.broadcast_delay);
+    set(line.request_gap, raw.request_gap);
     line.precise_timing = raw.precise_timing.value_or(default_precise_timing(line));
+    line.tcp_frame_gap = raw.tcp_frame_gap.value_or(default_byte_timeout(line));
+    set(line.connect_timeout, raw.connect_timeout);
+    line.reconnect_backoff = build_backoff(raw.reconnect_backoff, line.reconnect_backoff);
     line.read_retries = narrow<unsigned>(raw.read_retries, line.read_retries);
     line.offline_after = narrow<unsigned>(raw.offline_after, line.offline_after);
     line.offline_backoff = build_backoff(raw.offline_backoff, line.offline_backoff);

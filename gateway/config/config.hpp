@@ -183,6 +183,12 @@ struct DeviceConfig {
     static constexpr Range<milliseconds> delay_before_command_range{milliseconds{0}, seconds{1}};
     std::size_t queue_limit = 16;               ///< queued requests before exception 0x06
     static constexpr Range<std::int64_t> queue_limit_range{1, 1024};
+    /// Per-device pacing: at least this long between the end of one of its replies
+    /// (or its timeout) and the next request to it; other devices use the line meanwhile.
+    milliseconds request_gap{0};
+    /// After the line opens or reconnects, before the first request to this device.
+    milliseconds first_request_delay{0};
+    static constexpr Range<milliseconds> pacing_range{milliseconds{0}, std::chrono::minutes{1}};
     PollConfig poll;                            ///< not for `modbus`: blocks have periods
     bool allow_protected = false;               ///< device ID / flash save / baud / mode writes
     bool mqtt_commands = true;
@@ -195,7 +201,10 @@ struct DeviceConfig {
 
 struct LineConfig {
     std::string name;  ///< required; unique among lines
-    std::string port;  ///< required; absolute device path, unique among lines
+    std::string port;  ///< required; absolute device path or tcp://host:port, unique among lines
+    /// Set when `port` is tcp://host:port: the line is reached through a serial device
+    /// server in transparent mode (docs/service.md, "Serial device servers").
+    std::optional<TcpEndpoint> tcp;
     std::uint32_t baud = 115200;
     /// Rates the serial layer sets up (libmodbus maps exactly these to termios).
     static constexpr std::array<std::uint32_t, 13> standard_bauds{
@@ -228,6 +237,22 @@ struct LineConfig {
     /// whole silence is shorter than the lead (spun without a timer), else false.
     bool precise_timing = false;
     static constexpr std::chrono::microseconds precise_timing_lead{200};
+    /// Silence the gateway leaves between frames: at least t3.5 of the line's baud;
+    /// 0: t3.5 alone. Over TCP the device server forwards bytes as they come, so the
+    /// gateway keeps the silence of the far side's line.
+    milliseconds request_gap{0};
+    static constexpr Range<milliseconds> request_gap_range{milliseconds{0}, seconds{1}};
+    /// tcp:// ports only: a reply ends when its length is complete, or at a gap this
+    /// long between two segments (replaces byte_timeout, which a stream cannot see).
+    /// When absent from the file: 5ms, or 3.5 character times when that is longer.
+    milliseconds tcp_frame_gap{5};
+    static constexpr Range<milliseconds> tcp_frame_gap_range{milliseconds{1}, seconds{1}};
+    /// tcp:// ports only: how long a connection attempt may take.
+    milliseconds connect_timeout = seconds{2};
+    static constexpr Range<milliseconds> connect_timeout_range{milliseconds{10}, std::chrono::minutes{1}};
+    /// tcp:// ports only: the wait before connecting again after a failure, doubling
+    /// up to max (serial ports reopen on offline_backoff).
+    Backoff reconnect_backoff{milliseconds{250}, milliseconds{500}};
     unsigned read_retries = 1;  ///< writes are never retried (spec section 3 rule 6)
     static constexpr Range<std::int64_t> read_retries_range{0, 5};
     unsigned offline_after = 3;  ///< consecutive timeouts

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstring>
+#include <utility>
 
 namespace fieldbridge::config {
 
@@ -101,42 +102,72 @@ std::string ListenAddress::to_string() const {
     return is_ipv6() ? "[" + host + "]:" + std::to_string(port) : host + ":" + std::to_string(port);
 }
 
-Parsed<ListenAddress> parse_listen_address(std::string_view text) {
-    using Result = Parsed<ListenAddress>;
-    const std::string expected =
-        "expected an IP address and a port, e.g. 0.0.0.0:502, 127.0.0.1:1502 or [::1]:1502";
+namespace {
+
+using HostAndPort = std::pair<std::string, std::uint16_t>;
+
+/// "host:port" or "[IPv6]:port" (@p text; @p shown in the messages): an IPv6 literal
+/// in brackets, or a host @p host_ok accepts (@p host_kind says what it must be),
+/// and a port 1..65535. Every error ends with @p expected.
+Parsed<HostAndPort> parse_host_port(std::string_view text, std::string_view shown, bool (*host_ok)(std::string_view),
+                                    const char* host_kind, const std::string& expected) {
+    using Result = Parsed<HostAndPort>;
     std::string_view host;
     std::string_view port;
     if (!text.empty() && text.front() == '[') {
         const auto close = text.find(']');
         if (close == std::string_view::npos || close + 1 >= text.size() || text[close + 1] != ':') {
-            return Result::fail("'" + std::string(text) + "' is not a listen address; " + expected);
+            return Result::fail("'" + std::string(shown) + "' has no port after the IPv6 address; " + expected);
         }
         host = text.substr(1, close - 1);
         port = text.substr(close + 2);
-        if (!parse_ipv6(host)) {
-            return Result::fail("'" + std::string(host) + "' is not an IPv6 address; " + expected);
-        }
+        if (!parse_ipv6(host)) return Result::fail("'" + std::string(host) + "' is not an IPv6 address; " + expected);
     } else {
         const auto colon = text.rfind(':');
         if (colon == std::string_view::npos) {
-            return Result::fail("'" + std::string(text) + "' has no port; " + expected);
+            return Result::fail("'" + std::string(shown) + "' has no port; " + expected);
         }
         host = text.substr(0, colon);
         port = text.substr(colon + 1);
         if (host.find(':') != std::string_view::npos) {
-            return Result::fail("'" + std::string(text) + "': an IPv6 address needs brackets; " + expected);
+            return Result::fail("'" + std::string(shown) + "': an IPv6 address needs brackets; " + expected);
         }
-        if (!parse_ipv4(host)) {
-            return Result::fail("'" + std::string(host) +
-                                "' is not an IPv4 address (host names are not accepted for binding); " + expected);
-        }
+        if (!host_ok(host)) return Result::fail("'" + std::string(host) + "' is not " + host_kind + "; " + expected);
     }
     const auto port_number = parse_port(port);
-    if (!port_number) {
-        return Result::fail("'" + std::string(port) + "' is not a port; expected 1..65535");
+    if (!port_number) return Result::fail("'" + std::string(port) + "' is not a port; expected 1..65535");
+    return Result::ok(HostAndPort{std::string(host), *port_number});
+}
+
+bool is_ipv4(std::string_view host) { return parse_ipv4(host).has_value(); }
+
+}  // namespace
+
+Parsed<ListenAddress> parse_listen_address(std::string_view text) {
+    const auto parsed =
+        parse_host_port(text, text, &is_ipv4, "an IPv4 address (host names are not accepted for binding)",
+                        "expected an IP address and a port, e.g. 0.0.0.0:502, 127.0.0.1:1502 or [::1]:1502");
+    if (!parsed) return Parsed<ListenAddress>::fail(parsed.error);
+    return Parsed<ListenAddress>::ok(ListenAddress{parsed.value->first, parsed.value->second});
+}
+
+std::string TcpEndpoint::to_string() const {
+    const bool v6 = host.find(':') != std::string::npos;
+    return (v6 ? "[" + host + "]" : host) + ":" + std::to_string(port);
+}
+
+bool is_tcp_port(std::string_view port) noexcept { return port.starts_with(tcp_port_scheme); }
+
+Parsed<TcpEndpoint> parse_tcp_port(std::string_view text) {
+    const std::string expected =
+        "expected tcp://HOST:PORT, e.g. tcp://192.168.1.20:4001, tcp://[fd00::7]:4001 or tcp://nport-3:4001";
+    if (!is_tcp_port(text)) {
+        return Parsed<TcpEndpoint>::fail("'" + std::string(text) + "' does not start with tcp://; " + expected);
     }
-    return Result::ok(ListenAddress{std::string(host), *port_number});
+    const auto parsed = parse_host_port(text.substr(tcp_port_scheme.size()), text, &is_valid_host,
+                                        "a host name or an IPv4 address", expected);
+    if (!parsed) return Parsed<TcpEndpoint>::fail(parsed.error);
+    return Parsed<TcpEndpoint>::ok(TcpEndpoint{parsed.value->first, parsed.value->second});
 }
 
 bool is_valid_host(std::string_view host) {

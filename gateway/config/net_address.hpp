@@ -40,6 +40,25 @@ struct ListenAddress {
 /// "0.0.0.0:502" or "[::1]:1502".
 [[nodiscard]] Parsed<ListenAddress> parse_listen_address(std::string_view text);
 
+/// A line's port on a serial device server in transparent mode: `tcp://host:port`.
+struct TcpEndpoint {
+    std::string host;        ///< host name, IPv4 literal, or IPv6 literal without brackets
+    std::uint16_t port = 0;  ///< 1..65535
+
+    /// "192.168.1.20:4001", "[fd00::7]:4001", "nport-3.cell:4001".
+    [[nodiscard]] std::string to_string() const;
+    bool operator==(const TcpEndpoint&) const = default;
+};
+
+/// The scheme that makes a line's `port` a TCP endpoint instead of a device path.
+inline constexpr std::string_view tcp_port_scheme = "tcp://";
+
+/// True when @p port starts with `tcp://` (whether the rest is valid or not).
+[[nodiscard]] bool is_tcp_port(std::string_view port) noexcept;
+
+/// "tcp://192.168.1.20:4001", "tcp://[fd00::7]:4001", "tcp://nport-3.cell:4001".
+[[nodiscard]] Parsed<TcpEndpoint> parse_tcp_port(std::string_view text);
+
 /// A network: `10.0.0.0/8`, `fd00::/8`, or a single address (`192.168.1.5` = /32).
 struct Cidr {
     IpAddress network{};         ///< host bits are zero

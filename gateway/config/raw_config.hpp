@@ -125,6 +125,8 @@ struct RawDevice : RawNode {
     Field<std::chrono::milliseconds> command_ttl;
     Field<std::chrono::milliseconds> delay_before_command;
     Field<std::int64_t> queue_limit;
+    Field<std::chrono::milliseconds> request_gap;
+    Field<std::chrono::milliseconds> first_request_delay;
     RawPoll poll;
     Field<bool> allow_protected;
     Field<bool> mqtt_commands;
@@ -147,6 +149,10 @@ struct RawLine : RawNode {
     Field<std::chrono::milliseconds> turnaround;
     Field<std::chrono::milliseconds> broadcast_delay;
     Field<bool> precise_timing;
+    Field<std::chrono::milliseconds> request_gap;
+    Field<std::chrono::milliseconds> tcp_frame_gap;
+    Field<std::chrono::milliseconds> connect_timeout;
+    RawBackoff reconnect_backoff;
     Field<std::int64_t> read_retries;
     Field<std::int64_t> offline_after;
     RawBackoff offline_backoff;

@@ -42,7 +42,7 @@ RawBlock parse_block(const NodeRef& ref, DiagnosticSink& sink) {
 RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "type", "address", "unit_id", "max_age", "command_ttl", "delay_before_command",
-                         "queue_limit", "poll", "allow_protected", "mqtt_commands", "word_order", "stroke", "blocks"},
+                         "queue_limit", "request_gap", "first_request_delay", "poll", "allow_protected", "mqtt_commands", "word_order", "stroke", "blocks"},
                         sink);
     RawDevice raw;
     map.fill(raw);
@@ -54,6 +54,8 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
     raw.command_ttl = read_duration(map, "command_ttl");
     raw.delay_before_command = read_duration(map, "delay_before_command");
     raw.queue_limit = read_int(map, "queue_limit");
+    raw.request_gap = read_duration(map, "request_gap");
+    raw.first_request_delay = read_duration(map, "first_request_delay");
     raw.poll = parse_poll(map.child("poll"), sink);
     raw.allow_protected = read_bool(map, "allow_protected");
     raw.mqtt_commands = read_bool(map, "mqtt_commands");
@@ -66,7 +68,8 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
 RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "port", "baud", "parity", "data_bits", "stop_bits", "rs485", "local_echo",
-                         "response_timeout", "byte_timeout", "turnaround", "broadcast_delay", "precise_timing", "read_retries", "offline_after",
+                         "response_timeout", "byte_timeout", "turnaround", "broadcast_delay", "precise_timing", "request_gap", "tcp_frame_gap",
+                         "connect_timeout", "reconnect_backoff", "read_retries", "offline_after",
                          "offline_backoff", "broadcast_unit", "broadcast_share", "devices"},
                         sink);
     RawLine raw;
@@ -84,6 +87,10 @@ RawLine parse_line(const NodeRef& ref, DiagnosticSink& sink) {
     raw.turnaround = read_duration(map, "turnaround");
     raw.broadcast_delay = read_duration(map, "broadcast_delay");
     raw.precise_timing = read_bool(map, "precise_timing");
+    raw.request_gap = read_duration(map, "request_gap");
+    raw.tcp_frame_gap = read_duration(map, "tcp_frame_gap");
+    raw.connect_timeout = read_duration(map, "connect_timeout");
+    raw.reconnect_backoff = parse_backoff(map.child("reconnect_backoff"), sink);
     raw.read_retries = read_int(map, "read_retries");
     raw.offline_after = read_int(map, "offline_after");
     raw.offline_backoff = parse_backoff(map.child("offline_backoff"), sink);

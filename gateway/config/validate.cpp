@@ -49,7 +49,7 @@ std::chrono::milliseconds default_byte_timeout(const LineConfig& framing) {
 bool default_precise_timing(const LineConfig& line) {
     // Measured (docs/configuration.md): a spun silence without a timer costs no more
     // CPU than the timer's wake-ups; a timer plus a spin costs up to the lead.
-    return line.turnaround == std::chrono::milliseconds{0} &&
+    return line.turnaround == std::chrono::milliseconds{0} && line.request_gap == std::chrono::milliseconds{0} &&
            line.character_time() * 7 / 2 < LineConfig::precise_timing_lead;
 }
 

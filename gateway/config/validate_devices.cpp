@@ -158,6 +158,8 @@ void check_device(const RawDevice& device, std::chrono::milliseconds line_respon
                                            "expire; expected at least " + format_duration(line_response_timeout));
     }
     check_range(sink, device.delay_before_command, DeviceConfig::delay_before_command_range);
+    check_range(sink, device.request_gap, DeviceConfig::pacing_range);
+    check_range(sink, device.first_request_delay, DeviceConfig::pacing_range);
     check_range(sink, device.queue_limit, DeviceConfig::queue_limit_range);
     if (device.poll.ok()) {
         check_range(sink, device.poll.fast, PollConfig::period_range);

@@ -56,20 +56,68 @@ void check_timing(const RawLine& line, DiagnosticSink& sink) {
                            "), so no device could ever answer in time; expected at least " + format_duration(silence));
         }
     }
-    if (check_range(sink, line.byte_timeout, LineConfig::byte_timeout_range)) {
+    const auto check_gap = [&](const Field<std::chrono::milliseconds>& field, Range<std::chrono::milliseconds> range) {
+        if (!check_range(sink, field, range)) return;
         const auto gap = character_times(framing, 1.5);
-        if (*line.byte_timeout < gap) {
-            sink.error(line.byte_timeout, format_duration(*line.byte_timeout) +
-                                              " is shorter than the 1.5-character gap allowed inside a frame" + at +
-                                              " (" + format_ms(framing.character_time() * 3 / 2) +
-                                              "), so replies would be cut; expected at least " + format_duration(gap));
+        if (*field < gap) {
+            sink.error(field, format_duration(*field) + " is shorter than the 1.5-character gap allowed inside a frame" +
+                                  at + " (" + format_ms(framing.character_time() * 3 / 2) +
+                                  "), so replies would be cut; expected at least " + format_duration(gap));
         }
-    }
+    };
+    check_gap(line.byte_timeout, LineConfig::byte_timeout_range);
+    check_gap(line.tcp_frame_gap, LineConfig::tcp_frame_gap_range);
     check_range(sink, line.turnaround, LineConfig::turnaround_range);
     check_range(sink, line.broadcast_delay, LineConfig::broadcast_delay_range);
     check_range(sink, line.read_retries, LineConfig::read_retries_range);
     check_range(sink, line.offline_after, LineConfig::offline_after_range);
     check_backoff(sink, line.offline_backoff, LineConfig{}.offline_backoff);
+}
+
+/// A tcp:// port reaches the line through a serial device server: the RS-485 set-up
+/// and the echo of a local adapter are the device server's business, and a stream
+/// shows no inter-byte silence (tcp_frame_gap replaces byte_timeout). A serial port
+/// has no connection to time or retry.
+void check_transport(const RawLine& line, DiagnosticSink& sink) {
+    const bool tcp = line.port.has_value() && is_tcp_port(*line.port);
+    const std::string on_tcp = " does not apply to a tcp:// port: the serial device server drives the line";
+    if (tcp) {
+        if (!line.rs485.absent()) {
+            sink.error(line.rs485, "rs485" + on_tcp + "; set its RS-485 mode in the device server and remove rs485");
+        }
+        if (line.local_echo.has_value()) {
+            sink.error(line.local_echo, "local_echo" + on_tcp + "; remove it");
+        }
+        if (line.byte_timeout.has_value()) {
+            sink.error(line.byte_timeout, "byte_timeout does not apply to a tcp:// port (a stream shows no gaps "
+                                          "between bytes); use tcp_frame_gap instead");
+        }
+    } else {
+        const std::string on_serial = " applies to tcp:// ports only (a serial device server); remove it";
+        if (line.tcp_frame_gap.has_value()) sink.error(line.tcp_frame_gap, "tcp_frame_gap" + on_serial);
+        if (line.connect_timeout.has_value()) sink.error(line.connect_timeout, "connect_timeout" + on_serial);
+        if (!line.reconnect_backoff.absent()) {
+            sink.error(line.reconnect_backoff, "reconnect_backoff" + on_serial + " (serial ports reopen on offline_backoff)");
+        }
+    }
+    check_range(sink, line.request_gap, LineConfig::request_gap_range);
+    check_range(sink, line.connect_timeout, LineConfig::connect_timeout_range);
+    check_backoff(sink, line.reconnect_backoff, LineConfig{}.reconnect_backoff);
+}
+
+/// `port`: an absolute device path or tcp://host:port.
+void check_port(const RawLine& line, DiagnosticSink& sink) {
+    if (!require(sink, line.port, "the serial device path, e.g. /dev/ttyUSB0, or tcp://host:port")) return;
+    if (is_tcp_port(*line.port)) {
+        const auto endpoint = parse_tcp_port(*line.port);
+        if (!endpoint) sink.error(line.port, endpoint.error);
+        return;
+    }
+    if (!std::filesystem::path(*line.port).is_absolute()) {
+        sink.error(line.port, "'" + *line.port +
+                                  "' is not an absolute path; expected the serial device path, e.g. /dev/ttyUSB0 "
+                                  "or /dev/serial/by-id/..., or tcp://host:port for a serial device server");
+    }
 }
 
 }  // namespace
@@ -82,12 +130,8 @@ void validate_lines(const RawConfig& raw, DiagnosticSink& sink) {
         if (require(sink, line.name, "a line name such as line-a")) {
             check_name(sink, line.name);
         }
-        if (require(sink, line.port, "the serial device path, e.g. /dev/ttyUSB0") &&
-            !std::filesystem::path(*line.port).is_absolute()) {
-            sink.error(line.port, "'" + *line.port +
-                                      "' is not an absolute path; expected the serial device path, e.g. /dev/ttyUSB0 "
-                                      "or /dev/serial/by-id/...");
-        }
+        check_port(line, sink);
+        check_transport(line, sink);
         check_serial(line, sink);
         check_timing(line, sink);
         if (line.broadcast_unit.has_value()) {

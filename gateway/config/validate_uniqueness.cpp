@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cctype>
 #include <system_error>
 
 #include "config/validate.hpp"
@@ -29,7 +30,16 @@ void check_unique(std::vector<Seen>& seen, const std::string& key, const std::st
 
 /// The port path with ".", "..", duplicate slashes and existing symbolic links
 /// resolved, so /dev/serial/by-id/... and the /dev/ttyUSBn it points to compare equal.
+/// A tcp:// port is its endpoint, the host in lower case: a device server that
+/// accepts one client must never see a second connection from this gateway.
 [[nodiscard]] std::string normalized_port(const std::string& port) {
+    if (is_tcp_port(port)) {
+        auto endpoint = parse_tcp_port(port);
+        if (!endpoint) return port;  // reported by validate_lines
+        std::string key = endpoint.value->to_string();
+        std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return std::tolower(c); });
+        return "tcp://" + key;
+    }
     std::error_code ec;
     auto canonical = std::filesystem::weakly_canonical(std::filesystem::path(port), ec);
     if (ec) {
@@ -92,7 +102,7 @@ void check_ports_and_endpoints(const RawConfig& raw, DiagnosticSink& sink) {
         if (line.port.has_value() && !line.port->empty()) {
             // Spec section 7: two lines on one port is an error.
             check_unique(ports, normalized_port(*line.port), line.port.path, line.port.mark,
-                         "port " + *line.port, "one line per serial port", sink);
+                         "port " + *line.port, "one line per serial port or device server endpoint", sink);
         }
     }
     std::vector<Seen> endpoints;

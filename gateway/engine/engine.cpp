@@ -9,12 +9,14 @@
 #include "core/error.hpp"
 #include "engine/engine_settings.hpp"
 #include "engine/posix_serial_port.hpp"
+#include "engine/tcp_stream_port.hpp"
 #include "engine/profiles/profile_factory.hpp"
 
 namespace fieldbridge::engine {
 
 PortFactory posix_port_factory() {
     return [](const SerialSettings& settings) -> std::unique_ptr<SerialPort> {
+        if (settings.tcp) return std::make_unique<TcpStreamPort>(settings, ConnectWait::begin);
         return std::make_unique<PosixSerialPort>(settings);
     };
 }

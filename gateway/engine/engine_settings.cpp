@@ -5,6 +5,10 @@ namespace fieldbridge::engine {
 SerialSettings serial_settings(const config::LineConfig& line) {
     SerialSettings settings;
     settings.path = line.port;
+    if (line.tcp) {
+        settings.tcp = StreamEndpoint{line.tcp->host, line.tcp->port, line.connect_timeout};
+        return settings;  // the baud and format set the wire-time model only (line_timing)
+    }
     settings.baud = line.baud;
     settings.parity = line.parity;
     settings.data_bits = line.data_bits;
@@ -28,6 +32,9 @@ LineTimingConfig line_timing(const config::LineConfig& line) {
     timing.turnaround = line.turnaround;
     timing.broadcast_delay = line.broadcast_delay;
     timing.local_echo = line.local_echo;
+    timing.request_gap = line.request_gap;
+    timing.stream = line.tcp.has_value();
+    timing.frame_gap = line.tcp_frame_gap;
     // WTEC-485 ASCII timeouts are the manual's (seed 003, 1.1), not configurable; the
     // frame timeout is never shorter than the line's response timeout, so a slow
     // line configured for its Modbus devices does not cut ASCII replies short.
@@ -44,6 +51,11 @@ LineWorkerConfig line_worker_config(const config::LineConfig& line) {
     // we knock on something that is not there".
     worker.reopen_initial = line.offline_backoff.initial;
     worker.reopen_max = line.offline_backoff.max;
+    if (line.tcp) {
+        // A device server: its own key, as the upstreams' (docs/configuration.md).
+        worker.reopen_initial = line.reconnect_backoff.initial;
+        worker.reopen_max = line.reconnect_backoff.max;
+    }
     worker.spin_lead = line.precise_timing ? Duration{config::LineConfig::precise_timing_lead} : Duration::zero();
     return worker;
 }
@@ -55,6 +67,8 @@ DeviceLimits device_limits(const config::LineConfig& line, const config::DeviceC
     limits.offline_after = line.offline_after;
     limits.backoff_initial = line.offline_backoff.initial;
     limits.backoff_max = line.offline_backoff.max;
+    limits.request_gap = device.request_gap;
+    limits.first_request_delay = device.first_request_delay;
     return limits;
 }
 

@@ -100,6 +100,7 @@ void LineCore::on(TimePoint now, line_event::Stop&, LineStep& step) {
     const bool was_up = port_ == PortState::up;
     port_ = PortState::stopped;
     asked_ = LineNext::none;
+    opening_ = false;
     step.cancel_timers = true;
     step.close_port = true;
     exact_at_.reset();
@@ -159,10 +160,26 @@ void LineCore::request_drive(LineStep& step) {
 
 // ---- the port: open, failure, reopen ------------------------------------------------
 
+void LineCore::on(TimePoint, line_event::OpenPending&, LineStep&) {
+    if (!answered(LineNext::open, LineNext::open, "OpenPending")) return;
+    // The connect runs; Opened or OpenFailed comes as an event of its own, and the
+    // line stays down (or not started) meanwhile.
+    opening_ = true;
+}
+
+bool LineCore::open_answered(const char* event) {
+    if (opening_) {
+        opening_ = false;
+        return port_ != PortState::stopped;
+    }
+    return answered(LineNext::open, LineNext::open, event);
+}
+
 void LineCore::on(TimePoint now, line_event::Opened& event, LineStep& step) {
-    if (!answered(LineNext::open, LineNext::open, "Opened")) return;
+    if (!open_answered("Opened")) return;
     // Whatever was on the wire before is unknown: the silence counts from now.
     master_.reset(now);
+    scheduler_.line_opened(now);
     if (port_ == PortState::down) {
         ++reopens_;
         log_(LogLevel::info, "line " + config_.name + ": " + port_path_ + " reopened after " +
@@ -172,6 +189,7 @@ void LineCore::on(TimePoint now, line_event::Opened& event, LineStep& step) {
         log_(LogLevel::info, "line " + config_.name + ": " + port_path_ + " open, " + event.detail);
     }
     port_ = PortState::up;
+    quiet_ = RepeatedFailure{};
     open_attempts_ = 0;
     reopen_delay_ = config_.reopen_initial;
     step.watch_readable = true;
@@ -180,22 +198,38 @@ void LineCore::on(TimePoint now, line_event::Opened& event, LineStep& step) {
 }
 
 void LineCore::on(TimePoint now, line_event::OpenFailed& event, LineStep& step) {
-    if (!answered(LineNext::open, LineNext::open, "OpenFailed")) return;
+    if (!open_answered("OpenFailed")) return;
     if (port_ != PortState::down) {
         // The first open at start: the line starts down.
         port_ = PortState::down;
         reopen_delay_ = config_.reopen_initial;
         log_(LogLevel::error, "line " + config_.name + ": cannot open " + port_path_ + ": " + event.what +
-                                  "; check the adapter and its cable; retrying in " + duration_text(reopen_delay_));
+                                  cable_advice() + "; retrying in " + duration_text(reopen_delay_));
         scheduler_.cancel_all(OutcomeStatus::line_down, now);
         step.line_up = false;
     } else {
         reopen_delay_ = std::min(reopen_delay_ * 2, config_.reopen_max);
-        log_(LogLevel::warning, "line " + config_.name + ": reopening " + port_path_ + " failed (attempt " +
-                                    std::to_string(open_attempts_) + "): " + event.what + "; retrying in " +
-                                    duration_text(reopen_delay_));
+        log_reopen_failure(now, event.what);
     }
     schedule_reopen(now, step);
+}
+
+void LineCore::log_reopen_failure(TimePoint now, const std::string& what) {
+    // A device server switched off for an hour is thousands of attempts at a short
+    // back-off: once the back-off is at its maximum, a failure like the last one
+    // logged (also at the maximum) is logged at most once a minute, with a count.
+    const bool at_max = reopen_delay_ == config_.reopen_max;
+    if (at_max && quiet_.at_max && what == quiet_.what && now - quiet_.logged_at < repeat_log_interval) {
+        ++quiet_.suppressed;
+        return;
+    }
+    const std::string also = quiet_.suppressed == 0 ? std::string{}
+                                                    : " (" + std::to_string(quiet_.suppressed) +
+                                                          " more failures like it since the last such line)";
+    log_(LogLevel::warning, "line " + config_.name + ": reopening " + port_path_ + " failed (attempt " +
+                                std::to_string(open_attempts_) + "): " + what + "; retrying in " +
+                                duration_text(reopen_delay_) + also);
+    quiet_ = RepeatedFailure{what, now, at_max, 0};
 }
 
 void LineCore::on(TimePoint, line_event::ReopenDue&, LineStep& step) {
@@ -203,6 +237,11 @@ void LineCore::on(TimePoint, line_event::ReopenDue&, LineStep& step) {
     at_rest("ReopenDue");
     ++open_attempts_;
     ask(LineNext::open, step);
+}
+
+const char* LineCore::cable_advice() const noexcept {
+    // A device server's errors carry their own advice (engine/tcp_stream_port.cpp).
+    return config_.timing.stream ? "" : "; check the adapter and its cable";
 }
 
 void LineCore::schedule_reopen(TimePoint now, LineStep& step) { step.reopen_at = now + reopen_delay_; }
@@ -223,7 +262,7 @@ void LineCore::port_failed(TimePoint now, const char* operation, const std::stri
     reopen_delay_ = config_.reopen_initial;
     // `what` names the port and says what the error usually means.
     log_(LogLevel::error, "line " + config_.name + ": " + operation + " on the port failed: " + what +
-                              "; check the adapter and its cable; retrying in " + duration_text(reopen_delay_));
+                              cable_advice() + "; retrying in " + duration_text(reopen_delay_));
     if (auto finished = master_.abort(now)) {
         scheduler_.finished(std::move(finished->transaction), finished->outcome, now);
     }

@@ -16,7 +16,8 @@
 ///     deliveries  the scheduler's health changes then completions, called by the
 ///                 shell (LineDelivery) after the step: a handler may submit (the next
 ///                 event) or stop; then `line_up` (the line went up or down)
-///     next        open the port -> Opened / OpenFailed; read it once -> BytesRead /
+///     next        open the port -> Opened / OpenFailed (or OpenPending: a TCP
+///                 connect runs, Opened / OpenFailed follow as events); read it once -> BytesRead /
 ///                 PortFailed; write these bytes -> Written / WriteBlocked /
 ///                 PortFailed; resume (after the deliveries) or tick (with a fresh
 ///                 `now`) -> Resume; spin (busy-wait until `spin_until`, then a
@@ -114,6 +115,9 @@ struct ReopenDue {};
 struct Opened {
     std::string detail;
 };
+/// Answer to next == open: the open only began (a TCP connect); Opened or
+/// OpenFailed follows later as an event of its own, not as an answer.
+struct OpenPending {};
 /// Answer to next == open: it failed; @p what names the port and the cause.
 struct OpenFailed {
     std::string what;
@@ -143,7 +147,8 @@ struct Resume {};
 using LineEvent =
     std::variant<line_event::Start, line_event::Stop, line_event::Submit, line_event::RemoveDevice,
                  line_event::Drive, line_event::Readable, line_event::Writable, line_event::TimerFired,
-                 line_event::ReopenDue, line_event::Opened, line_event::OpenFailed, line_event::BytesRead,
+                 line_event::ReopenDue, line_event::OpenPending, line_event::Opened, line_event::OpenFailed,
+                 line_event::BytesRead,
                  line_event::Written, line_event::WriteBlocked, line_event::PortFailed, line_event::Resume>;
 
 /// The one answer a step waits for (see the file comment).
@@ -213,6 +218,7 @@ private:
     void on(TimePoint now, line_event::Writable& event, LineStep& step);
     void on(TimePoint now, line_event::TimerFired& event, LineStep& step);
     void on(TimePoint now, line_event::ReopenDue& event, LineStep& step);
+    void on(TimePoint now, line_event::OpenPending& event, LineStep& step);
     void on(TimePoint now, line_event::Opened& event, LineStep& step);
     void on(TimePoint now, line_event::OpenFailed& event, LineStep& step);
     void on(TimePoint now, line_event::BytesRead& event, LineStep& step);
@@ -221,6 +227,10 @@ private:
     void on(TimePoint now, line_event::PortFailed& event, LineStep& step);
     void on(TimePoint now, line_event::Resume& event, LineStep& step);
 
+    /// Opened / OpenFailed: the answer to open, or the end of a pending open.
+    [[nodiscard]] bool open_answered(const char* event);
+    [[nodiscard]] const char* cable_advice() const noexcept;
+    void log_reopen_failure(TimePoint now, const std::string& what);
     /// False for a stale answer after Stop; throws for an answer nobody asked for.
     [[nodiscard]] bool answered(LineNext first, LineNext second, const char* event);
     /// Throws std::logic_error when the shell owes an answer (a reactor event arrived
@@ -247,6 +257,16 @@ private:
     std::vector<Transaction> inbox_;  ///< submitted, not yet handed to the scheduler
     PortState port_ = PortState::idle;
     LineNext asked_ = LineNext::none;  ///< the question the shell is answering
+    bool opening_ = false;  ///< OpenPending: the shell reports the open's end later
+    /// The last reopen failure logged (log_reopen_failure).
+    struct RepeatedFailure {
+        std::string what;
+        TimePoint logged_at{};
+        bool at_max = false;  ///< the back-off was at its maximum then
+        unsigned suppressed = 0;
+    };
+    static constexpr Duration repeat_log_interval = std::chrono::minutes{1};
+    RepeatedFailure quiet_;
     Duration reopen_delay_;
     unsigned open_attempts_ = 0;  ///< since the line went down (or since start)
     std::uint64_t reopens_ = 0;

@@ -52,7 +52,7 @@ void LineMaster::reset(TimePoint now) {
 TimePoint LineMaster::last_activity() const noexcept { return std::max(last_tx_end_, last_rx_); }
 
 TimePoint LineMaster::earliest_send() const noexcept {
-    Duration silence = timing_.t3_5();
+    Duration silence = std::max<Duration>(timing_.t3_5(), config_.request_gap);
     if (transaction_) silence = std::max(silence, transaction_->delay_before);
     return std::max(last_activity() + silence, guard_until_);
 }
@@ -102,7 +102,8 @@ void LineMaster::transition(MasterState next, TimePoint now, const char* why) {
                 const bool ascii = is_ascii(*transaction_);
                 reply_deadline_ = last_tx_end_ + (ascii ? config_.ascii_frame_timeout
                                                         : config_.response_timeout);
-                gap_limit_ = ascii ? config_.ascii_char_timeout : config_.byte_timeout;
+                gap_limit_ = config_.stream ? config_.frame_gap
+                                            : (ascii ? config_.ascii_char_timeout : config_.byte_timeout);
                 hard_deadline_ = reply_deadline_ +
                                  timing_.wire_time(max_reply_size(*transaction_)) + gap_limit_;
             }
@@ -279,6 +280,15 @@ void LineMaster::on_bytes(protocol::ByteView bytes, TimePoint now) {
         case MasterState::sending:
         case MasterState::discarding_echo:
         case MasterState::awaiting_reply: {
+            if (late_on_stream(now)) {
+                counters_.garbage_bytes += bytes.size();
+                if (log_.enabled(LogLevel::debug)) {
+                    log_(LogLevel::debug, describe() + ": dropped " + std::to_string(bytes.size()) +
+                                              " bytes that came before the request could have left the device "
+                                              "server (a late reply to an earlier request)");
+                }
+                return;
+            }
             const protocol::ByteView rest = take_echo(bytes);
             rx_.insert(rx_.end(), rest.begin(), rest.end());
             if (state_ == MasterState::discarding_echo && echo_seen_ == request_.size()) {
@@ -288,6 +298,17 @@ void LineMaster::on_bytes(protocol::ByteView bytes, TimePoint now) {
             return;
         }
     }
+}
+
+bool LineMaster::late_on_stream(TimePoint now) const noexcept {
+    // Over TCP the request reaches the far side's line only after it was written,
+    // and takes its wire time there: no byte of its reply can arrive before
+    // on_written + request bytes x tc (last_tx_end_). Whatever comes earlier, and
+    // before a reply began, answers an earlier request that timed out: dropped, never
+    // matched to this one. (On a serial line such bytes would collide with the
+    // request on the wire.)
+    if (!config_.stream || !rx_.empty()) return false;
+    return state_ == MasterState::sending || now < last_tx_end_;
 }
 
 void LineMaster::scan(TimePoint now) {
@@ -300,7 +321,9 @@ void LineMaster::scan(TimePoint now) {
             // device did answer, so say so now instead of waiting for a timeout.
             const bool misfit = result.framed && result.error != protocol::DecodeError::wrong_address;
             drop(std::min(result.consumed, rx_.size()), result.error, result.framed);
-            if (misfit) {
+            // On a TCP line a frame with more bytes behind it in the same segment is an
+            // earlier request's late reply (below): the scan goes on.
+            if (misfit && !(config_.stream && !rx_.empty())) {
                 counters_.garbage_bytes += rx_.size();
                 rx_.clear();
                 guard_until_ = now + config_.turnaround;
@@ -310,6 +333,19 @@ void LineMaster::scan(TimePoint now) {
             continue;
         }
         counters_.garbage_bytes += result.skipped;
+        if (config_.stream && result.consumed < rx_.size()) {
+            // A TCP line: more bytes came after a whole reply. The device answers once
+            // per request, so the earlier frame answered an earlier request (held by
+            // the device server and sent with the new one): the newest frame is the
+            // answer. Dropped, never matched; the scan goes on with what follows.
+            counters_.garbage_bytes += result.consumed - result.skipped;
+            if (log_.enabled(LogLevel::debug)) {
+                log_(LogLevel::debug, describe() + ": dropped a whole reply followed by more bytes in the same "
+                                                   "segment (a late reply to an earlier request)");
+            }
+            rx_.erase(rx_.begin(), rx_.begin() + static_cast<std::ptrdiff_t>(result.consumed));
+            continue;
+        }
         // Bytes after the reply in the same read belong to nothing we asked for.
         counters_.garbage_bytes += rx_.size() - std::min(result.consumed, rx_.size());
         rx_.clear();

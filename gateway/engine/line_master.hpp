@@ -36,6 +36,11 @@
 ///    byte_timeout. WTEC ASCII uses ascii_frame_timeout and ascii_char_timeout.
 ///  - a broadcast is written, then the line settles for t3.5 + turnaround, then it
 ///    finishes `broadcast_sent`; no reply is awaited.
+///  - a TCP line (config.stream, a serial device server): a reply ends at its
+///    predicted length or at a gap of frame_gap; bytes that arrive before the request
+///    can have crossed the far side's line (written + its wire time) are a late reply
+///    to an earlier request, and dropped; the silence before a request is
+///    max(t3.5, request_gap) on every line.
 ///  - local echo (2-wire adapters): the first bytes received after a write are
 ///    compared with the bytes sent and discarded, exactly as many as were sent.
 
@@ -137,6 +142,8 @@ private:
     [[nodiscard]] line_action::Finished hand_out(TimePoint now);
     /// Consumes the local echo at the front of @p bytes; returns what follows it.
     [[nodiscard]] protocol::ByteView take_echo(protocol::ByteView bytes);
+    /// A TCP line: bytes now cannot begin the reply to the request in flight.
+    [[nodiscard]] bool late_on_stream(TimePoint now) const noexcept;
     void scan(TimePoint now);
     void drop(std::size_t count, protocol::DecodeError why, bool framed);
     void drop_partial();

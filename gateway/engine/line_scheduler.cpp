@@ -139,7 +139,17 @@ Duration LineScheduler::poll_age(const Transaction& transaction) const noexcept 
 }
 
 bool LineScheduler::eligible(const Device& device, TimePoint now) const noexcept {
-    return device.online || now >= device.probe_due;
+    return (device.online || now >= device.probe_due) && now >= device.paced_until;
+}
+
+TimePoint LineScheduler::ready_at(const Device& device) noexcept {
+    return device.online ? device.paced_until : std::max(device.probe_due, device.paced_until);
+}
+
+void LineScheduler::line_opened(TimePoint now) {
+    for (auto& [index, device] : devices_) {
+        device.paced_until = std::max(device.paced_until, now + device.limits.first_request_delay);
+    }
 }
 
 LineScheduler::Rank LineScheduler::rank(const Device& device, const Entry& entry,
@@ -368,6 +378,8 @@ void LineScheduler::finished(Transaction transaction, const Outcome& outcome, Ti
         complete(std::move(transaction), outcome);
         return;
     }
+    // Pacing counts from the end of the device's last transaction on the wire.
+    if (transaction.attempts > 0) device->paced_until = now + device->limits.request_gap;
     const DeviceIndex index = transaction.device;
     if (outcome.status == OutcomeStatus::ok || outcome.status == OutcomeStatus::bad_reply) {
         // A reply that does not fit the request is still an answer: the device is
@@ -412,7 +424,7 @@ std::optional<TimePoint> LineScheduler::next_wakeup(TimePoint now) const {
     for (const auto& [index, device] : devices_) {
         if (device.queue.empty()) continue;
         if (eligible(device, now)) return now;
-        consider(device.probe_due);
+        consider(ready_at(device));
         for (const Entry& entry : device.queue) {
             if (entry.transaction.deadline) consider(*entry.transaction.deadline);
         }

@@ -23,6 +23,10 @@
 ///  - an offline device's due probe goes after live requests of its class, and
 ///    competes as a live request once it has been due for one more back-off interval.
 ///
+/// Pacing: a device with a `request_gap` or a `first_request_delay` is not eligible
+/// until its pacing instant (the end of its last transaction + request_gap; the line's
+/// open + first_request_delay); the other devices take the line meanwhile.
+///
 /// Deadlines (rule 9): a transaction whose deadline has passed is completed `expired`
 /// when it is submitted, and whenever the scheduler looks at its queues (next, expire).
 ///
@@ -75,6 +79,11 @@ struct DeviceLimits {
     unsigned offline_after = 3;
     Duration backoff_initial = std::chrono::seconds{1};
     Duration backoff_max = std::chrono::seconds{30};
+    /// Pacing: at least this long from the end of one of the device's transactions to
+    /// the next request to it (other devices use the line meanwhile).
+    Duration request_gap = Duration::zero();
+    /// After the line opens or reconnects (line_opened), before the first request.
+    Duration first_request_delay = Duration::zero();
 };
 
 struct SchedulerConfig {
@@ -178,6 +187,9 @@ public:
     /// all queues are empty.
     [[nodiscard]] std::optional<TimePoint> next_wakeup(TimePoint now) const;
 
+    /// The line's port opened at @p now: each device waits its first_request_delay.
+    void line_opened(TimePoint now);
+
     /// Completes every queued transaction whose deadline has passed.
     void expire(TimePoint now);
 
@@ -220,6 +232,7 @@ private:
         unsigned consecutive_timeouts = 0;
         Duration backoff{};
         TimePoint probe_due{};
+        TimePoint paced_until{};  ///< request_gap / first_request_delay: not before
         DeviceStats stats;
     };
     struct Rank;
@@ -228,6 +241,8 @@ private:
     [[nodiscard]] Device* find(DeviceIndex device) noexcept;
     [[nodiscard]] const Device* find(DeviceIndex device) const noexcept;
     [[nodiscard]] bool eligible(const Device& device, TimePoint now) const noexcept;
+    /// When eligible() turns true by time alone (probe due, pacing).
+    [[nodiscard]] static TimePoint ready_at(const Device& device) noexcept;
     [[nodiscard]] Rank rank(const Device& device, const Entry& entry, TimePoint now) const noexcept;
     [[nodiscard]] Duration poll_age(const Transaction& transaction) const noexcept;
     void sweep_expired(TimePoint now);

@@ -99,6 +99,15 @@ struct LineTimingConfig {
     /// T = 50 ms; used for ASCII transactions instead of byte/response timeouts.
     Duration ascii_char_timeout = std::chrono::milliseconds{5};
     Duration ascii_frame_timeout = std::chrono::milliseconds{50};
+    /// The silence between frames the gateway keeps: at least t3.5; longer when set.
+    Duration request_gap = Duration::zero();
+    /// The line is a TCP stream to a serial device server: no inter-byte silence is
+    /// visible, so a reply ends at its predicted length or at a gap of `frame_gap`
+    /// between segments (instead of byte_timeout / ascii_char_timeout), and bytes that
+    /// arrive before a request can have left the device server are a late reply to an
+    /// earlier request (LineMaster).
+    bool stream = false;
+    Duration frame_gap = std::chrono::milliseconds{5};
 
     [[nodiscard]] CharacterFormat format() const noexcept {
         return CharacterFormat{baud, data_bits, parity, stop_bits};

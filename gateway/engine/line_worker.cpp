@@ -37,7 +37,8 @@ public:
           port_(io, std::move(port)),
           exact_(io, WakeTimer::exact),
           lazy_(io, WakeTimer::lazy),
-          reopen_timer_(io) {}
+          reopen_timer_(io),
+          connect_timer_(io) {}
 
     ~Impl() { stop(); }
     Impl(const Impl&) = delete;
@@ -115,7 +116,13 @@ private:
     }
 
     void apply(const LineStep& step) {
-        if (step.close_port) port_.close();
+        if (step.close_port) {
+            // A connect in progress ends with the port: its wait is aborted, its timer
+            // must not fire into the next open.
+            ++connect_generation_;
+            connect_timer_.cancel();
+            port_.close();
+        }
         if (step.cancel_timers) {
             exact_.timer.cancel();
             lazy_.timer.cancel();
@@ -171,7 +178,39 @@ private:
         } catch (const SerialPortError& error) {
             return line_event::OpenFailed{error.what()};
         }
-        return line_event::Opened{to_string(port_.low_latency())};
+        if (port_.opening()) {
+            await_connect();
+            return line_event::OpenPending{};
+        }
+        return line_event::Opened{port_.open_detail()};
+    }
+
+    /// A TCP connect runs: the loop goes on, and the connect's end (the fd writable) or
+    /// its timeout feeds Opened / OpenFailed.
+    void await_connect() {
+        const std::uint64_t generation = ++connect_generation_;
+        const auto timeout = port_.open_timeout();
+        connect_timer_.expires_after(timeout);
+        connect_timer_.async_wait(guarded([this, generation, timeout](const asio::error_code& error) {
+            if (error == asio::error::operation_aborted || generation != connect_generation_) return;
+            ++connect_generation_;
+            port_.close();
+            feed(line_event::OpenFailed{core_.port_path() + ": no answer within " + std::to_string(timeout.count()) +
+                                        " ms (connect_timeout); check that the device server is powered and "
+                                        "reachable and that its address and port are right"});
+        }));
+        port_.wait_writable(guarded([this, generation](const asio::error_code& error) {
+            if (error == asio::error::operation_aborted || generation != connect_generation_) return;
+            ++connect_generation_;
+            connect_timer_.cancel();
+            try {
+                port_.finish_open();
+            } catch (const SerialPortError& failure) {
+                feed(line_event::OpenFailed{failure.what()});
+                return;
+            }
+            feed(line_event::Opened{port_.open_detail()});
+        }));
     }
 
     LineEvent read() {
@@ -215,6 +254,8 @@ private:
     Wake exact_;  ///< short waits, set to the instant
     Wake lazy_;   ///< long waits, may wake early (LineCore::arm_wake)
     asio::steady_timer reopen_timer_;
+    asio::steady_timer connect_timer_;  ///< a TCP connect's timeout
+    std::uint64_t connect_generation_ = 0;  ///< tells the current connect from one that ended
     LineStateCallback on_state_;
     std::shared_ptr<char> alive_ = std::make_shared<char>('\0');
 };

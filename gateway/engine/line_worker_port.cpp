@@ -30,7 +30,16 @@ void LinePort::open() {
         port_->close();
         throw SerialPortError("serial port " + port_->settings().path +
                               ": cannot wait for readiness on it (" + error.message() +
-                              "); the path must name a character device");
+                              "); the path must name a character device or a tcp:// endpoint");
+    }
+}
+
+void LinePort::finish_open() {
+    try {
+        port_->finish_open();
+    } catch (const SerialPortError&) {
+        close();
+        throw;
     }
 }
 

@@ -9,9 +9,11 @@
 #include <asio/io_context.hpp>
 #include <asio/posix/stream_descriptor.hpp>
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "engine/serial_port.hpp"
@@ -34,7 +36,12 @@ public:
     void close() noexcept;
     [[nodiscard]] bool is_open() const noexcept;
     [[nodiscard]] const SerialSettings& settings() const noexcept { return port_->settings(); }
-    [[nodiscard]] LowLatency low_latency() const noexcept { return port_->low_latency(); }
+    [[nodiscard]] std::string open_detail() const { return port_->open_detail(); }
+    /// The open only began (a TCP connect): wait_writable(), then finish_open().
+    [[nodiscard]] bool opening() const noexcept { return port_->opening(); }
+    /// Throws SerialPortError (the port is closed again then).
+    void finish_open();
+    [[nodiscard]] std::chrono::milliseconds open_timeout() const noexcept { return port_->open_timeout(); }
 
     /// What the driver accepts now (0: it would block). Throws SerialPortError.
     [[nodiscard]] std::size_t write_some(protocol::ByteView bytes);

@@ -1,11 +1,14 @@
 #pragma once
 /// @file serial_port.hpp
-/// The seam around a serial port. A line worker owns exactly one SerialPort; tests
-/// inject a fake. Reads and writes are non-blocking: the worker waits for
-/// readiness on native_handle() in its event loop.
+/// The seam around a line's byte stream: a serial port (PosixSerialPort) or a TCP
+/// connection to a serial device server in transparent mode (TcpStreamPort). A line
+/// worker owns exactly one SerialPort; tests inject a fake. Reads and writes are
+/// non-blocking: the worker waits for readiness on native_handle() in its event loop.
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -25,8 +28,18 @@ public:
     using core::Error::Error;
 };
 
+/// A line behind a serial device server (`tcp://host:port`).
+struct StreamEndpoint {
+    std::string host;  ///< host name, IPv4, or IPv6 without brackets
+    std::uint16_t port = 0;
+    std::chrono::milliseconds connect_timeout{2000};
+};
+
 struct SerialSettings {
-    std::string path;
+    std::string path;  ///< the device path, or the tcp://host:port of a device server
+    /// Set: the line is a TCP stream to a device server; the baud, parity and bits
+    /// describe the far side's line (wire time) and the rs485 fields do not apply.
+    std::optional<StreamEndpoint> tcp;
     unsigned baud = 115200;
     core::Parity parity = core::Parity::none;
     unsigned data_bits = 8;
@@ -63,6 +76,17 @@ public:
     [[nodiscard]] virtual const SerialSettings& settings() const noexcept = 0;
     /// What the driver said to the low-latency request of the last open() (for the log).
     [[nodiscard]] virtual LowLatency low_latency() const noexcept { return {}; }
+    /// What the last open() set up, for the log (a serial port: the low-latency answer).
+    [[nodiscard]] virtual std::string open_detail() const { return to_string(low_latency()); }
+
+    /// True when open() only began (a TCP connect in progress, the fd open): the fd
+    /// turns writable when it completes, then the caller calls finish_open().
+    [[nodiscard]] virtual bool opening() const noexcept { return false; }
+    /// Completes the open that open() began. Throws SerialPortError (refused, ...);
+    /// the port is closed then.
+    virtual void finish_open() {}
+    /// How long an open that only began may take before the caller gives up.
+    [[nodiscard]] virtual std::chrono::milliseconds open_timeout() const noexcept { return {}; }
 };
 
 }  // namespace fieldbridge::engine

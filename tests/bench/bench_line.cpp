@@ -49,6 +49,7 @@
 #include "percentile.hpp"
 #include "process_cpu.hpp"
 #include "raw_master.hpp"
+#include "read_load.hpp"
 #include "engine_harness.hpp"
 #include "sim_process.hpp"
 #include "stall_probe.hpp"
@@ -68,42 +69,6 @@ constexpr std::uint16_t status_address = 0x0300;  // position + status, input re
 constexpr std::uint16_t speed_address = 0x0631;   // "move: speed": a parameter, moves nothing alone
 
 double ms(Clock::duration d) { return duration<double, std::milli>(d).count(); }
-
-/// Keeps a fixed number of status reads queued on one device: each answer submits the
-/// next, so the line never runs dry. stop() lets the outstanding reads finish without
-/// submitting more (in_flight() tells when they have); start() again resumes.
-class ReadLoad {
-public:
-    explicit ReadLoad(engine::DeviceAgent& agent) : agent_(agent) {}
-    void start(unsigned count) {
-        stopping_ = false;
-        for (unsigned i = 0; i < count; ++i) submit();
-    }
-    void stop() { stopping_ = true; }
-    [[nodiscard]] std::uint64_t completed() const noexcept { return completed_; }
-    [[nodiscard]] std::uint64_t failed() const noexcept { return failed_; }
-    [[nodiscard]] unsigned in_flight() const noexcept { return in_flight_; }
-
-private:
-    void submit() {
-        ++in_flight_;
-        agent_.request(integration::read_input(status_address, 2), [this](const protocol::Response& response) {
-            --in_flight_;
-            if (integration::registers_of(response).size() == 2) {
-                ++completed_;
-            } else {
-                ++failed_;
-            }
-            if (!stopping_) submit();
-        });
-    }
-
-    engine::DeviceAgent& agent_;
-    bool stopping_ = false;
-    unsigned in_flight_ = 0;
-    std::uint64_t completed_ = 0;
-    std::uint64_t failed_ = 0;
-};
 
 std::string engine_yaml(const std::string& port, std::uint32_t baud) {
     // Polls slowed down so that (a) measures the on-demand reads alone; max_age 0: every
@@ -166,7 +131,7 @@ int run(double run_seconds, int write_count, std::uint32_t baud) {
                 "the engine (16 reads outstanding on line-a), %d alternating pairs of %.1f s windows, %u bit/s ==\n",
                 pairs, run_seconds, baud);
     const auto counter = [](const nlohmann::json& bus, const char* name) { return bus.value(name, std::uint64_t{0}); };
-    ReadLoad reads(xeg);
+    bench::ReadLoad reads(xeg, status_address);
     bench::FloorPairs floor_pairs;
     std::vector<double> window_tps;
     std::vector<double> window_cpu;

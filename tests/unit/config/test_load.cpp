@@ -57,7 +57,7 @@ TEST_CASE("the example configuration loads and uses every section") {
     CHECK(config->gateway.id == "cell-7");
     CHECK(config->modbus_tcp.rules.size() == 3);
     CHECK(config->modbus_tcp.allow.size() == 2);
-    REQUIRE(config->lines.size() == 2);
+    REQUIRE(config->lines.size() == 3);
     const auto& line = config->lines[0];
     REQUIRE(line.devices.size() == 4);
     CHECK(line.devices[0].type == DeviceType::hiwin_xeg);
@@ -70,6 +70,11 @@ TEST_CASE("the example configuration loads and uses every section") {
     CHECK(line.broadcast_unit == UnitId{100});
     CHECK(line.broadcast_share == 10U);
     CHECK(config->lines[1].devices.at(0).type == DeviceType::wtec_rtu);
+    // A line behind a serial device server, with a paced meter.
+    REQUIRE(config->lines[2].tcp.has_value());
+    CHECK(config->lines[2].tcp->to_string() == "192.168.1.30:4001");
+    CHECK(config->lines[2].devices.at(0).request_gap == std::chrono::milliseconds{20});
+    CHECK(config->lines[2].devices.at(0).first_request_delay == std::chrono::seconds{1});
     REQUIRE(config->upstreams.size() == 1);
     CHECK(config->upstreams[0].units.at(0).unit_id == UnitId{50});
     CHECK(config->mqtt.enabled);

@@ -80,7 +80,9 @@ struct FakeLine {
                     event = ev::Resume{};
                     break;
                 case fe::LineNext::open:
-                    if (open_failure) {
+                    if (open_pending) {
+                        event = ev::OpenPending{};
+                    } else if (open_failure) {
                         event = ev::OpenFailed{*open_failure};
                     } else {
                         event = ev::Opened{"low latency: test"};
@@ -170,6 +172,7 @@ struct FakeLine {
     Bytes written;
     std::size_t write_capacity = std::numeric_limits<std::size_t>::max();
     std::optional<std::string> open_failure;
+    bool open_pending = false;  ///< answer open with OpenPending (a TCP connect runs)
     std::optional<std::string> read_failure;
     TimePoint last_write_at{};
     std::vector<Bytes> arrive_during_spin;  ///< in the port's buffer once the next spin ends

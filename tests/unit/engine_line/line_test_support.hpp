@@ -166,6 +166,7 @@ public:
         scheduler_.finished(std::move(transaction), outcome, now);
         deliver();
     }
+    void line_opened(TimePoint now) { scheduler_.line_opened(now); }
     void expire(TimePoint now) {
         scheduler_.expire(now);
         deliver();
