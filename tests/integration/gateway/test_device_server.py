@@ -4,12 +4,10 @@ server in transparent mode in front of each pseudo-terminal) on `port: tcp://...
 Reads, writes, broadcast and WTEC ASCII work as on a tty; a write goes before queued
 reads; replies split across segments are joined; a late reply and two replies in one
 segment are never matched to the next request; a device's request_gap paces it; a
-server that closes mid-reply or
-refuses connections for a while is reconnected (within a second of its return); a
-reload never opens a second connection; `scan --port tcp://` scans through it; and
+server that closes mid-reply or refuses connections for a while is reconnected
+(within a second of its return); a reload never opens a second connection; `scan --port tcp://` scans through it; and
 check-config refuses serial-only options and names that do not resolve."""
 
-import os
 import signal
 import subprocess
 import threading
