@@ -3,12 +3,11 @@ simulator's buses through loopback TCP ports (devserverlib.DeviceServer, a devic
 server in transparent mode in front of each pseudo-terminal) on `port: tcp://...`.
 Reads, writes, broadcast and WTEC ASCII work as on a tty; a write goes before queued
 reads; replies split across segments are joined; a late reply and two replies in one
-segment are never matched to the next request; a server that closes mid-reply or
-refuses connections for a while is reconnected (within a second of its return); a
-reload never opens a second connection; `scan --port tcp://` scans through it; and
+segment are never matched to the next request; a device's request_gap paces it; a
+server that closes mid-reply or refuses connections for a while is reconnected
+(within a second of its return); a reload never opens a second connection; `scan --port tcp://` scans through it; and
 check-config refuses serial-only options and names that do not resolve."""
 
-import os
 import signal
 import subprocess
 import threading
@@ -54,7 +53,7 @@ lines:
         address: 1
         unit_id: 10
         max_age: 0ms
-        command_ttl: 2s
+        command_ttl: 2s{meter_extra}
         blocks:
           - {{table: holding, address: 0, count: 1, period: 1h, writable: true}}
           - {{table: holding, address: 10, count: 1, period: 1h, writable: true}}
@@ -63,7 +62,7 @@ lines:
 
 class DeviceServerCell(gatewaylib.CellTestCase):
 
-    def start_servers_and_gateway(self, meter_timeout="200ms"):
+    def start_servers_and_gateway(self, meter_timeout="200ms", meter_extra=""):
         self.tcp_port = gatewaylib.free_port()
         self.sim = simlib.Sim(["--bus", self.path("line-a") + ":hiwin-xeg@2,excd203mb@3,wtec-ascii@5",
                                "--bus", self.path("line-m") + ":modbus@1",
@@ -73,6 +72,7 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         self.addCleanup(self.server_a.close)
         self.addCleanup(self.server_m.close)
         self.config_path = self.path("gateway.yaml")
+        self.meter_extra = meter_extra
         self.write_config(meter_timeout)
         self.start_gateway()
         self.client_ = self.client()
@@ -83,7 +83,7 @@ class DeviceServerCell(gatewaylib.CellTestCase):
     def write_config(self, meter_timeout):
         with open(self.config_path, "w", encoding="utf-8") as f:
             f.write(CONFIG.format(tcp_port=self.tcp_port, port_a=self.server_a.port, port_m=self.server_m.port,
-                                  meter_timeout=meter_timeout))
+                                  meter_timeout=meter_timeout, meter_extra=self.meter_extra))
 
     def meter(self, register, client=None):
         reply = (client or self.client_).read_holding_registers(register, 1, slave=METER)
@@ -163,6 +163,21 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         for _ in range(10):
             self.assertEqual(self.meter(0), 1234)
             self.assertEqual(self.read_input(self.client_, XEG_FIRMWARE, 4, XEG), [3, 0, 1, 884])
+
+    def test_a_paced_device_waits_its_request_gap(self):
+        self.start_servers_and_gateway(meter_extra="\n        request_gap: 150ms")
+        xeg_client = self.client()
+        self.meter(0)
+        started = time.monotonic()
+        for _ in range(4):
+            self.assertIsNotNone(self.meter(0))
+        paced = time.monotonic() - started
+        xeg_started = time.monotonic()
+        for _ in range(4):
+            self.assertEqual(self.read_input(xeg_client, XEG_FIRMWARE, 4, XEG), [3, 0, 1, 884])
+        print("4 paced meter reads: %.0f ms; 4 XEG reads on the other line: %.0f ms"
+              % (paced * 1e3, (time.monotonic() - xeg_started) * 1e3))
+        self.assertGreaterEqual(paced, 4 * 0.150)
 
     # -- replies that are not the answer -------------------------------------------------
 
