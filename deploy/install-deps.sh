@@ -2,16 +2,34 @@
 # Installs every build, runtime and test dependency of fieldbridge from Debian 12
 # packages. Idempotent: packages already present are left alone, and apt is only
 # asked when something is missing. Needs root (or sudo) when it has to install.
+# Usage: deploy/install-deps.sh [--arch arm64|armhf]...
+#   --arch ARCH  also what a cross build for the Debian architecture ARCH needs
+#                (docs/build.md, "Cross builds"): the cross compiler, qemu-user, and a
+#                target root of the libraries below made by deploy/cross/make-sysroot.
 set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
+cross_arches=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --arch) [ $# -ge 2 ] || { echo "install-deps: --arch needs arm64 or armhf" >&2; exit 2; }
+            cross_arches+=("$2"); shift 2 ;;
+    *) echo "install-deps: unknown argument '$1' (usage: install-deps.sh [--arch arm64|armhf]...)" >&2; exit 2 ;;
+  esac
+done
+
+# The libraries the build links or includes (docs/dependencies.md says why each one is
+# here); a cross build gets the same set for its target in its own root.
+libraries=(
+  libmodbus-dev libpaho-mqttpp-dev libpaho-mqtt-dev libssl-dev libyaml-cpp-dev
+  libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
+  libcli11-dev libmicrohttpd-dev
+)
 packages=(
   # toolchain
   build-essential cmake ninja-build g++ pkg-config
   clang libclang-rt-14-dev  # the fuzz build (tests/fuzz): clang++ and its libFuzzer
-  # libraries (docs/dependencies.md says why each one is here)
-  libmodbus-dev libpaho-mqttpp-dev libpaho-mqtt-dev libssl-dev libyaml-cpp-dev
-  libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
-  libcli11-dev libmicrohttpd-dev
+  "${libraries[@]}"
   # test and demo tools
   socat mosquitto mosquitto-clients mbpoll curl python3 python3-pymodbus
   prometheus  # promtool check metrics (tests/integration/gateway/test_metrics.py)
@@ -20,6 +38,15 @@ packages=(
   # systemd for systemd-analyze and systemd-sysusers, man-db for man --warnings
   debhelper dpkg-dev lintian man-db systemd
 )
+for arch in "${cross_arches[@]}"; do
+  case "$arch" in
+    arm64|armhf) ;;
+    *) echo "install-deps: no cross build for '$arch' (arm64 or armhf)" >&2; exit 2 ;;
+  esac
+  # The compiler runs here (amd64 packages); the target's libraries come from its root;
+  # qemu-user runs the target's programs (the tests, --version); mmdebstrap makes the root.
+  packages+=("crossbuild-essential-$arch" qemu-user mmdebstrap)
+done
 
 missing=()
 for p in "${packages[@]}"; do
@@ -28,8 +55,16 @@ for p in "${packages[@]}"; do
   fi
 done
 
+make_sysroots() {
+  local arch
+  for arch in "${cross_arches[@]}"; do
+    "$here/deploy/cross/make-sysroot" "$arch" "${libraries[@]}"
+  done
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
+  make_sysroots
   exit 0
 fi
 
@@ -50,3 +85,4 @@ $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 # not needed and is left as the package set it up.
 # Likewise the prometheus package (wanted for promtool only) sets up a system
 # Prometheus server on port 9090; the tests do not use it.
+make_sysroots

@@ -98,7 +98,7 @@ void check_topics(const RawMqtt& mqtt, DiagnosticSink& sink) {
             problem = "starts with $ (reserved for the broker, MQTT 3.1.1 section 4.7.2)";
         } else if (prefix.size() > MqttConfig::max_prefix_length) {
             problem = "is longer than " + std::to_string(MqttConfig::max_prefix_length) + " characters";
-        } else if (std::any_of(prefix.begin(), prefix.end(), [](char c) { return c >= 0 && c < ' '; })) {
+        } else if (std::any_of(prefix.begin(), prefix.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; })) {
             problem = "contains control characters";
         }
         if (!problem.empty()) {

@@ -14,59 +14,38 @@
 # the user and group if this script's install created them. It refuses to run when
 # either package is already installed.
 #
-# Usage: tests/package/test-package.sh
+# With --arch arm64 or armhf, the packages cross-built for that architecture
+# (deploy/build-deb --arch, docs/build.md "Cross builds"), which this machine cannot
+# install: their architecture, lintian, the Depends computed from the target's
+# libraries, the same files as this machine's packages (built first when they are
+# not there), and the packaged fieldbridge and fieldbridge-sim run under qemu-user:
+# --version, --check-config on the packaged configuration, --help, and the demo cell's
+# Modbus TCP reads and writes through the packaged daemon against this machine's
+# simulator (tests/integration/gateway/test_modbus_devices.py).
+#
+# Usage: tests/package/test-package.sh [--arch ARCH]
 #   FIELDBRIDGE_DEB_DIR        where the packages are built (default build-deb/)
 #   FIELDBRIDGE_DEB_PREBUILT=1 test the packages already in that directory, no build
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 out="${FIELDBRIDGE_DEB_DIR:-$here/build-deb}"
 export FIELDBRIDGE_DEB_DIR="$out"
-
-SUDO=()
-if [ "$(id -u)" -ne 0 ]; then
-  if command -v sudo >/dev/null 2>&1; then SUDO=(sudo); else
-    echo "test-package: installs packages with apt-get: run as root or install sudo" >&2
-    exit 1
-  fi
+native="$(dpkg --print-architecture)"
+arch="$native"
+if [ "${1:-}" = --arch ]; then
+  [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
+  arch="$2"
 fi
-as_root() { "${SUDO[@]}" "$@"; }
 
 started=$SECONDS
-installed() {  # installed PACKAGE: dpkg knows it in any state but not-installed (config-files too)
-  local status
-  status="$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" || return 1
-  [ -n "$status" ] && [ "${status##* }" != not-installed ]
-}
-for p in fieldbridge fieldbridge-sim; do
-  if installed "$p"; then
-    echo "test-package: $p is already installed (or its configuration is left); this test installs and" \
-         "purges it. Purge it first: apt-get purge $p" >&2
-    exit 1
-  fi
-done
-user_existed=0; getent passwd fieldbridge >/dev/null && user_existed=1
-group_existed=0; getent group fieldbridge >/dev/null && group_existed=1
-
-cleanup() {
-  local rc=$?
-  for p in fieldbridge-sim fieldbridge; do
-    if installed "$p"; then as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "$p" >/dev/null || rc=1; fi
-  done
-  # Debian leaves system users in place on purge; this test removes the one it made.
-  if [ "$user_existed" = 0 ] && getent passwd fieldbridge >/dev/null; then as_root userdel fieldbridge || rc=1; fi
-  if [ "$group_existed" = 0 ] && getent group fieldbridge >/dev/null; then as_root groupdel fieldbridge || rc=1; fi
-  exit $rc
-}
-trap cleanup EXIT
-
 if [ "${FIELDBRIDGE_DEB_PREBUILT:-0}" != 1 ]; then
   mkdir -p "$out"
   build_started=$SECONDS
-  "$here/deploy/build-deb" > "$out/build-deb.log" 2>&1 || { tail -50 "$out/build-deb.log" >&2; echo "test-package: deploy/build-deb failed (log: $out/build-deb.log)" >&2; exit 1; }
-  echo "test-package: deploy/build-deb took $((SECONDS - build_started)) s (log: $out/build-deb.log)"
+  log="$out/build-deb-$arch.log"
+  "$here/deploy/build-deb" --arch "$arch" > "$log" 2>&1 || { tail -50 "$log" >&2; echo "test-package: deploy/build-deb --arch $arch failed (log: $log)" >&2; exit 1; }
+  echo "test-package: deploy/build-deb --arch $arch took $((SECONDS - build_started)) s (log: $log)"
 fi
 version="$(sed -n 's/^project(fieldbridge VERSION \([0-9][0-9.]*\).*/\1/p' "$here/CMakeLists.txt")"
-arch="$(dpkg --print-architecture)"
 deb="$out/fieldbridge_${version}_${arch}.deb"
 sim_deb="$out/fieldbridge-sim_${version}_${arch}.deb"
 
@@ -95,6 +74,50 @@ check "lintian: no error or warning" lintian --fail-on error,warning --display-i
 check "dependencies computed by dpkg-shlibdeps (libmodbus, paho, yaml-cpp, libsystemd)" \
   contains "$(dpkg-deb -f "$deb" Depends)" 'libmodbus5.*libpaho-mqttpp3-1.*libsystemd0.*libyaml-cpp0'
 
+if [ "$arch" != "$native" ]; then
+  . "$here/tests/package/cross-checks.sh"
+  echo "test-package: $((SECONDS - started)) s in all"
+  echo "package ($arch): $passed passed, $failed failed"
+  [ "$failed" -eq 0 ]
+  exit
+fi
+
+SUDO=()
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO=(sudo); else
+    echo "test-package: installs packages with apt-get: run as root or install sudo" >&2
+    exit 1
+  fi
+fi
+as_root() { "${SUDO[@]}" "$@"; }
+
+installed() {  # installed PACKAGE: dpkg knows it in any state but not-installed (config-files too)
+  local status
+  status="$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" || return 1
+  [ -n "$status" ] && [ "${status##* }" != not-installed ]
+}
+for p in fieldbridge fieldbridge-sim; do
+  if installed "$p"; then
+    echo "test-package: $p is already installed (or its configuration is left); this test installs and" \
+         "purges it. Purge it first: apt-get purge $p" >&2
+    exit 1
+  fi
+done
+user_existed=0; getent passwd fieldbridge >/dev/null && user_existed=1
+group_existed=0; getent group fieldbridge >/dev/null && group_existed=1
+
+cleanup() {
+  local rc=$?
+  for p in fieldbridge-sim fieldbridge; do
+    if installed "$p"; then as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "$p" >/dev/null || rc=1; fi
+  done
+  # Debian leaves system users in place on purge; this test removes the one it made.
+  if [ "$user_existed" = 0 ] && getent passwd fieldbridge >/dev/null; then as_root userdel fieldbridge || rc=1; fi
+  if [ "$group_existed" = 0 ] && getent group fieldbridge >/dev/null; then as_root groupdel fieldbridge || rc=1; fi
+  exit $rc
+}
+trap cleanup EXIT
+
 check "apt-get install ./fieldbridge_*.deb ./fieldbridge-sim_*.deb" \
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$deb" "$sim_deb"
 
@@ -121,7 +144,7 @@ check "fieldbridge-sim --help" /usr/bin/fieldbridge-sim --help
 # one transaction of its normal idle time (the same test runs in ctest with the
 # sanitizer build's looser bounds).
 check "hitless reload on the installed binaries: no failed request, no reopened port, no gap over one transaction" \
-  env FIELDBRIDGE_RELEASE_BUILD=1 PYTHONPATH="$here/tests/integration/gateway:$here/tests/integration/sim" \
+  env FIELDBRIDGE_RELEASE_BUILD=1 PYTHONPATH="$here/tests/integration/gateway:$here/tests/integration/sim:$here/tests/integration" \
   /usr/bin/python3 "$here/tests/integration/gateway/test_hitless_reload.py" \
   --gateway /usr/bin/fieldbridge --sim /usr/bin/fieldbridge-sim
 check "systemd-analyze verify on the installed units: silent" \

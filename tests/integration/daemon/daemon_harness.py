@@ -15,6 +15,8 @@ import tempfile
 import threading
 import time
 
+from emulation import target_command
+
 # Generous bounds for a loaded 2-core machine and sanitizer builds; a healthy run
 # answers in milliseconds.
 TIMEOUT = 15.0
@@ -152,7 +154,7 @@ class Gateway:
         info = os.fstat(write_end)
         # systemd.exec(5): JOURNAL_STREAM is "<st_dev>:<st_ino>" of the stderr stream.
         self.pipe_identity = "%d:%d" % (info.st_dev, info.st_ino)
-        command = [binary] + list(args)
+        command = target_command(binary, *args)
         if watchdog_pid_is_self:
             # WATCHDOG_PID must be the PID of the process itself, which is only
             # known after fork: exec from a shell whose PID the binary inherits.
@@ -257,5 +259,5 @@ class DaemonTestCase:
         return write_file(self.tmp, name, text)
 
     def run_binary(self, args):
-        return subprocess.run([self.binary] + list(args), stdin=subprocess.DEVNULL, capture_output=True, text=True,
+        return subprocess.run(target_command(self.binary, *args), stdin=subprocess.DEVNULL, capture_output=True, text=True,
                               env=clean_environment(), timeout=TIMEOUT)

@@ -22,6 +22,7 @@ import time
 import unittest
 
 import simlib
+from emulation import target_command, target_file
 
 try:
     from pymodbus.client import ModbusTcpClient
@@ -421,7 +422,7 @@ class CellTestCase(unittest.TestCase):
             f.write(text.replace(old, new, 1))
 
     def start_gateway(self, launcher=(), wait_ready=True):
-        self.gateway = Process("fieldbridge", list(launcher) + [GATEWAY, "--config", self.config_path],
+        self.gateway = Process("fieldbridge", list(launcher) + target_command(GATEWAY, "--config", self.config_path),
                                self.path("gateway.log"), env=environment())
         self.processes.append(self.gateway)
         if wait_ready:

@@ -12,6 +12,7 @@ import struct
 import subprocess
 import time
 
+import emulation
 import gatewaylib
 from gatewaylib import mbap, read_frame
 
@@ -70,7 +71,9 @@ class GenericFunctions(gatewaylib.CellTestCase):
             self.fail("FB_LIBMODBUS_SLAVE is not set (the ctest entry sets it)")
 
     def start(self):
-        slave = subprocess.Popen([SLAVE, self.path("line-c"), "7"], stdout=subprocess.PIPE, text=True)
+        # Built with the gateway: in a cross build it runs under the target's emulator.
+        slave = subprocess.Popen(emulation.target_command(SLAVE, self.path("line-c"), "7"), stdout=subprocess.PIPE,
+                                 text=True)
         self.addCleanup(slave.wait, 5)
         self.addCleanup(slave.kill)
         self.assertEqual(slave.stdout.readline().strip(), "ready")

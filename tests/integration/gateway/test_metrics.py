@@ -196,9 +196,11 @@ class Metrics(gatewaylib.CellTestCase):
     # -- helpers ---------------------------------------------------------------------
 
     def mapped_libraries(self, *prefixes):
-        """Which of the file name prefixes the gateway process maps (/proc/<pid>/maps)."""
+        """Which of the file name prefixes the gateway process maps (/proc/<pid>/maps); under
+        an emulator, of the files of the gateway's root (emulation.target_file)."""
         with open("/proc/%d/maps" % self.gateway.pid, encoding="utf-8") as f:
-            names = {line.split()[-1].rsplit("/", 1)[-1] for line in f if "/" in line}
+            paths = [line.split()[-1] for line in f if "/" in line]
+        names = {path.rsplit("/", 1)[-1] for path in paths if gatewaylib.target_file(path)}
         return {prefix for prefix in prefixes if any(name.startswith(prefix + ".so") for name in names)}
 
     def reload(self, expected):
@@ -208,7 +210,7 @@ class Metrics(gatewaylib.CellTestCase):
         self.assertIsNotNone(found, "no %r after SIGHUP:\n%s" % (expected, self.gateway.text()))
 
     def version(self):
-        done = subprocess.run([gatewaylib.GATEWAY, "--version"], capture_output=True, text=True,
+        done = subprocess.run(gatewaylib.target_command(gatewaylib.GATEWAY, "--version"), capture_output=True, text=True,
                               timeout=gatewaylib.IO_TIMEOUT)
         return done.stdout.split()[-1]
 
