@@ -7,6 +7,7 @@
 #include <charconv>
 #include <utility>
 
+#include "core/log_text.hpp"
 #include "daemon/journal_priority.hpp"
 
 namespace fieldbridge::daemon {
@@ -14,6 +15,8 @@ namespace fieldbridge::daemon {
 namespace {
 
 constexpr char journal_flag = 'J';
+/// spdlog's own message flag, replaced: no pattern can write a message unescaped.
+constexpr char message_flag = 'v';
 constexpr const char* journal_pattern = "%J%v";
 constexpr const char* human_pattern = "%Y-%m-%d %H:%M:%S.%e [%l] %v";
 
@@ -27,6 +30,26 @@ constexpr const char* human_pattern = "%Y-%m-%d %H:%M:%S.%e [%l] %v";
     }
     return value;
 }
+
+/// %v: the message in the escape form of core/log_text.hpp. Strings from outside
+/// (MQTT topics and payloads, Modbus TCP peers, HTTP requests, upstream replies) reach
+/// log messages at many call sites; escaping here, once, means none can forge a line
+/// or send the operator's terminal an escape sequence.
+class EscapedMessageFlag final : public spdlog::custom_flag_formatter {
+public:
+    void format(const spdlog::details::log_msg& msg, const std::tm& /*tm_time*/, spdlog::memory_buf_t& dest) override {
+        const std::string_view text(msg.payload.data(), msg.payload.size());
+        if (!core::needs_log_escape(text)) {
+            dest.append(text.data(), text.data() + text.size());
+            return;
+        }
+        const std::string escaped = core::escape_log_text(text);
+        dest.append(escaped.data(), escaped.data() + escaped.size());
+    }
+    [[nodiscard]] std::unique_ptr<spdlog::custom_flag_formatter> clone() const override {
+        return std::make_unique<EscapedMessageFlag>();
+    }
+};
 
 }  // namespace
 
@@ -57,6 +80,7 @@ LogFormat detect_log_format(const char* journal_stream, int fd) noexcept {
 std::unique_ptr<spdlog::formatter> make_formatter(LogFormat format) {
     auto formatter = std::make_unique<spdlog::pattern_formatter>();
     formatter->add_flag<JournalPriorityFlag>(journal_flag);
+    formatter->add_flag<EscapedMessageFlag>(message_flag);
     formatter->set_pattern(format == LogFormat::journal ? journal_pattern : human_pattern);
     return formatter;
 }

@@ -1,7 +1,10 @@
 #pragma once
 /// @file logging.hpp
 /// The gateway's logger: spdlog to stderr, with journald priority prefixes when
-/// stderr is connected to the journal, a human format otherwise.
+/// stderr is connected to the journal, a human format otherwise. Every message is
+/// written in the escape form of core/log_text.hpp (control characters and bytes
+/// that are not UTF-8 as `\n`, `\xHH`...): one message is one line, whatever text
+/// from outside it carries.
 ///
 /// The logger is created once in main() and handed to every component as a
 /// `std::shared_ptr<spdlog::logger>`; nothing registers it in spdlog's global
@@ -40,7 +43,8 @@ enum class LogFormat {
 /// but writes elsewhere (a terminal, a redirect) gets the human format.
 [[nodiscard]] LogFormat detect_log_format(const char* journal_stream, int fd) noexcept;
 
-/// The pattern formatter for @p format ("%J%v" or the human pattern).
+/// The pattern formatter for @p format ("%J%v" or the human pattern), whose %v is
+/// the escaped message.
 [[nodiscard]] std::unique_ptr<spdlog::formatter> make_formatter(LogFormat format);
 
 /// A logger named @p name writing to @p sink in @p format. Not registered in

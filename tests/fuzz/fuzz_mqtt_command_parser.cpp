@@ -2,7 +2,8 @@
 // bridge calls it for a `<prefix>/<device>/cmd` payload: with the device's operations
 // (its profile's) and its register image (WTEC `grip` / `release` read the init direction).
 // A parsed command's requests go to the device as they are, so each must encode;
-// a refusal must say why.
+// a refusal must say why. The op and the refusal's message reach the log: escaped for
+// it (core/log_text.hpp), nothing of them may need escaping any more (one printable line).
 // Input: one byte choosing the device type's operations, one byte choosing how many registers
 // (0-3) the image holds, 5 bytes per register (table, address, value), then the payload.
 
@@ -16,6 +17,7 @@
 
 #include "fuzz_input.hpp"
 #include "core/error.hpp"
+#include "core/log_text.hpp"
 #include "engine/profiles/excd_profile.hpp"
 #include "engine/profiles/wtec_common.hpp"
 #include "engine/profiles/xeg_profile.hpp"
@@ -50,7 +52,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string_view payload(reinterpret_cast<const char*>(payload_bytes.data()), payload_bytes.size());
 
     const auto result = mqtt::parse_command(payload, set, registers);
+    const auto loggable = [](std::string_view text) {
+        return !fieldbridge::core::needs_log_escape(fieldbridge::core::escape_log_text(text));
+    };
     if (const auto* parsed = std::get_if<mqtt::ParsedCommand>(&result)) {
+        FB_FUZZ_CHECK(loggable(parsed->op));
         FB_FUZZ_CHECK(!parsed->requests.empty() && !parsed->op.empty());
         FB_FUZZ_CHECK(parsed->id.is_string() || parsed->id.is_number());
         for (const auto& request : parsed->requests) {
@@ -63,7 +69,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             FB_FUZZ_CHECK(encodes);
         }
     } else {
-        FB_FUZZ_CHECK(!std::get<mqtt::CommandError>(result).message.empty());
+        const auto& error = std::get<mqtt::CommandError>(result);
+        FB_FUZZ_CHECK(!error.message.empty());
+        FB_FUZZ_CHECK(loggable(error.message) && loggable(error.op));
     }
     return 0;
 }

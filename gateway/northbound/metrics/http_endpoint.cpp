@@ -4,12 +4,18 @@
 #include <cerrno>
 #include <exception>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <map>
+#include <optional>
 #include <string_view>
 #include <utility>
 
 #include <asio/ip/tcp.hpp>
+#include <asio/post.hpp>
 #include <asio/posix/stream_descriptor.hpp>
 #include <asio/steady_timer.hpp>
 #include <fmt/format.h>
@@ -102,11 +108,15 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
 
     void start(int listen_fd, const HttpEndpointLimits& limits) {
         port = bound_port(listen_fd);
-        daemon = mhd.start_daemon(MHD_USE_EPOLL, 0, nullptr, nullptr, &Core::on_request, this,
-                                 MHD_OPTION_LISTEN_SOCKET, listen_fd,
-                                 MHD_OPTION_CONNECTION_LIMIT, static_cast<unsigned int>(limits.max_connections),
-                                 MHD_OPTION_CONNECTION_TIMEOUT,
-                                 static_cast<unsigned int>(limits.connection_timeout.count()), MHD_OPTION_END);
+        max_connections = limits.max_connections;
+        header_timeout = limits.request_header_timeout;
+        daemon = mhd.start_daemon(
+            MHD_USE_EPOLL, 0, nullptr, nullptr, &Core::on_request, this, MHD_OPTION_LISTEN_SOCKET, listen_fd,
+            MHD_OPTION_CONNECTION_LIMIT, static_cast<unsigned int>(limits.max_connections),
+            MHD_OPTION_PER_IP_CONNECTION_LIMIT, static_cast<unsigned int>(limits.max_connections_per_address),
+            MHD_OPTION_CONNECTION_TIMEOUT, static_cast<unsigned int>(limits.connection_timeout.count()),
+            MHD_OPTION_NOTIFY_CONNECTION, &Core::on_connection, static_cast<void*>(this),
+            MHD_OPTION_NOTIFY_COMPLETED, &Core::on_completed, static_cast<void*>(this), MHD_OPTION_END);
         if (daemon == nullptr) {
             ::close(listen_fd);
             throw MetricsHttpError(fmt::format("metrics HTTP: cannot serve on {}: libmicrohttpd did not start (out of "
@@ -119,12 +129,13 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
                                                "descriptor (built without epoll support?)",
                                                address.to_string()));
         }
-        ready.assign(info->epoll_fd);
+        epoll_fd = info->epoll_fd;
+        ready.assign(epoll_fd);
         watch();
         schedule();
     }
 
-    /// Waits until MHD's epoll set has something ready.
+    /// Waits until MHD's epoll set has something new ready (asio: edge-triggered).
     void watch() {
         ready.async_wait(asio::posix::stream_descriptor::wait_read,
                          [weak = weak_from_this()](const asio::error_code& error) {
@@ -135,24 +146,114 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
                          });
     }
 
-    /// MHD's own deadline (idle connections); zero when it has work left over.
+    /// The next of MHD's own deadline (idle connections; zero when it has work left
+    /// over) and the request-header deadlines.
     void schedule() {
+        std::optional<std::chrono::steady_clock::time_point> at;
         MHD_UNSIGNED_LONG_LONG timeout_ms = 0;
-        if (mhd.get_timeout(daemon, &timeout_ms) != MHD_YES) {
+        if (mhd.get_timeout(daemon, &timeout_ms) == MHD_YES) {
+            at = std::chrono::steady_clock::now() +
+                 std::chrono::milliseconds{static_cast<std::chrono::milliseconds::rep>(timeout_ms)};
+        }
+        if (const auto earliest = std::min_element(
+                header_deadlines.begin(), header_deadlines.end(),
+                [](const auto& a, const auto& b) { return a.second < b.second; });
+            earliest != header_deadlines.end()) {
+            at = at ? std::min(*at, earliest->second) : earliest->second;
+        }
+        if (!at) {
             timer.cancel();
             return;
         }
-        timer.expires_after(std::chrono::milliseconds{static_cast<std::chrono::milliseconds::rep>(timeout_ms)});
+        timer.expires_at(*at);
         timer.async_wait([weak = weak_from_this()](const asio::error_code& error) {
             const auto self = weak.lock();
             if (!self || error) return;
+            self->cut_late_headers();
             self->run();
         });
     }
 
+    /// Ends every connection whose request header is overdue: shutdown() of its socket
+    /// (MHD's, not closed here), so MHD reads the end of stream and closes it in the
+    /// next run, freeing its slot.
+    void cut_late_headers() {
+        const auto now = std::chrono::steady_clock::now();
+        for (auto it = header_deadlines.begin(); it != header_deadlines.end();) {
+            if (it->second > now) {
+                ++it;
+                continue;
+            }
+            if (const MHD_ConnectionInfo* info = mhd.get_connection_info(it->first, MHD_CONNECTION_INFO_CONNECTION_FD);
+                info != nullptr) {
+                ::shutdown(info->connect_fd, SHUT_RDWR);
+            }
+            it = header_deadlines.erase(it);
+        }
+    }
+
+    [[nodiscard]] unsigned connections() const {
+        const MHD_DaemonInfo* info = mhd.get_daemon_info(daemon, MHD_DAEMON_INFO_CURRENT_CONNECTIONS);
+        return info != nullptr ? info->num_connections : 0;
+    }
+
+    /// True while MHD's epoll set still reports something ready (a level check: the
+    /// watch above would not hear of it again).
+    [[nodiscard]] bool still_ready() const {
+        pollfd check{epoll_fd, POLLIN, 0};
+        return ::poll(&check, 1, 0) > 0 && (check.revents & POLLIN) != 0;
+    }
+
+    /// MHD_run() until it leaves nothing that only a next run would do. A run that
+    /// closed connections is followed by another: MHD takes its listening socket out of
+    /// its epoll set at the connection limit and puts it back only at the start of a
+    /// run, so without it clients waiting in the listen backlog (and every later one)
+    /// would never be accepted once the connections at the limit had gone. What is
+    /// still ready afterwards runs again from the loop, after what else is waiting.
     void run() {
-        mhd.run(daemon);
+        for (unsigned pass = 0; pass <= max_connections; ++pass) {
+            const unsigned before = connections();
+            mhd.run(daemon);
+            if (connections() >= before) break;
+        }
+        if (still_ready() && !rerun_posted) {
+            rerun_posted = true;
+            asio::post(timer.get_executor(), [weak = weak_from_this()] {
+                const auto self = weak.lock();
+                if (!self) return;
+                self->rerun_posted = false;
+                self->run();
+            });
+        }
         schedule();
+    }
+
+    /// MHD_NotifyConnectionCallback: a connection starts waiting for its first request
+    /// header, or is gone.
+    static void on_connection(void* cls, MHD_Connection* connection, void** /*socket_context*/,
+                              MHD_ConnectionNotificationCode code) {
+        auto& core = *static_cast<Core*>(cls);
+        try {
+            if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+                core.header_deadlines[connection] = std::chrono::steady_clock::now() + core.header_timeout;
+            } else {
+                core.header_deadlines.erase(connection);
+            }
+        } catch (...) {
+            // Out of memory: this connection has only the idle timeout.
+        }
+    }
+
+    /// MHD_RequestCompletedCallback: an answer was sent; the next request header has
+    /// the same time from now.
+    static void on_completed(void* cls, MHD_Connection* connection, void** /*request_state*/,
+                             MHD_RequestTerminationCode /*code*/) {
+        auto& core = *static_cast<Core*>(cls);
+        try {
+            core.header_deadlines[connection] = std::chrono::steady_clock::now() + core.header_timeout;
+        } catch (...) {
+            // As above.
+        }
     }
 
     static MHD_Result on_request(void* cls, MHD_Connection* connection, const char* url, const char* method,
@@ -160,7 +261,9 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
                                  void** /*request_state*/) {
         // The try/catch wall of a C callback: nothing may unwind through MHD.
         try {
-            return static_cast<Core*>(cls)->answer(connection, url, method) ? MHD_YES : MHD_NO;
+            auto& core = *static_cast<Core*>(cls);
+            core.header_deadlines.erase(connection);  // the header is complete
+            return core.answer(connection, url, method) ? MHD_YES : MHD_NO;
         } catch (...) {
             return MHD_NO;
         }
@@ -192,6 +295,12 @@ struct HttpEndpoint::Core : std::enable_shared_from_this<HttpEndpoint::Core> {
     asio::steady_timer timer;
     MHD_Daemon* daemon = nullptr;
     std::uint16_t port = 0;
+    int epoll_fd = -1;  ///< MHD's; watched through `ready`
+    unsigned max_connections = 0;
+    std::chrono::seconds header_timeout{};
+    /// Connections waiting for a request header, and until when.
+    std::map<MHD_Connection*, std::chrono::steady_clock::time_point> header_deadlines;
+    bool rerun_posted = false;
 };
 
 HttpEndpoint::HttpEndpoint(asio::io_context& io, const config::ListenAddress& address, Render render,

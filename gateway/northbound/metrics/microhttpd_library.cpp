@@ -53,6 +53,7 @@ const MicrohttpdApi& load_microhttpd(const std::string& library, const std::stri
         resolve(handle, "MHD_start_daemon", api.start_daemon, library, context);
         resolve(handle, "MHD_stop_daemon", api.stop_daemon, library, context);
         resolve(handle, "MHD_get_daemon_info", api.get_daemon_info, library, context);
+        resolve(handle, "MHD_get_connection_info", api.get_connection_info, library, context);
         resolve(handle, "MHD_get_timeout", api.get_timeout, library, context);
         resolve(handle, "MHD_run", api.run, library, context);
         resolve(handle, "MHD_create_response_from_buffer", api.create_response_from_buffer, library, context);

@@ -5,6 +5,7 @@
 
 #include <asio/post.hpp>
 
+#include "core/log_text.hpp"
 #include "northbound/mqtt/command_parser.hpp"
 #include "northbound/mqtt/command_runner.hpp"
 #include "northbound/mqtt/payloads.hpp"
@@ -497,7 +498,7 @@ private:
         };
         const auto it = devices_.find(name);
         if (it == devices_.end()) {
-            refuse("unknown_device", "no device '" + name + "' on this gateway");
+            refuse("unknown_device", "no device " + core::quoted(name) + " on this gateway");
             return;
         }
         if (message.retained) {
@@ -529,7 +530,7 @@ private:
     void answer(const std::string& name, const json& id, const std::string& op, const CommandOutcome& outcome) {
         if (!outcome.ok) ++stats_.commands_failed;
         log(outcome.ok ? LogLevel::info : LogLevel::warning,
-            "MQTT: command " + id.dump() + " '" + op + "' to " + name +
+            "MQTT: command " + id.dump() + " " + core::quoted(op) + " to " + core::quoted(name) +
                 (outcome.ok ? std::string(": ok") : ": " + outcome.error + ": " + outcome.message));
         send(Message{topic(name, "cmd/result"), command_result_payload(name, id, op, outcome, ClockPair::now()).dump(),
                      s_.qos, false});

@@ -10,7 +10,11 @@
 #include <utility>
 
 #include <asio/post.hpp>
+#include <asio/steady_timer.hpp>
 #include <mqtt/async_client.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "core/error.hpp"
 #include "northbound/mqtt/inbound_gate.hpp"
@@ -36,6 +40,20 @@ struct TokenInfo {
     return info;
 }
 
+/// After an oversize message: how long the loop waits before giving memory back
+/// (Paho frees its copies of the message when the message callback has returned).
+constexpr std::chrono::milliseconds trim_delay{200};
+
+/// Returns the free pages of every malloc arena to the system. Paho reads a message
+/// whole, in two or three copies on its own thread's arena; glibc keeps what a large
+/// free leaves below its mmap threshold, so one big message would otherwise stay in
+/// the process's resident set.
+void release_free_memory() noexcept {
+#if defined(__GLIBC__)
+    ::malloc_trim(0);
+#endif
+}
+
 }  // namespace
 
 PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic) {
@@ -53,6 +71,9 @@ PahoOptions paho_options(const config::MqttConfig& config, const std::string& wi
     o.max_inbound_messages = config.max_queued_commands;
     o.max_inbound_bytes = config.max_queued_command_bytes;
     o.max_payload_bytes = config.max_command_bytes;
+    if (config.version == config::MqttVersion::v5) {
+        o.max_packet_bytes = static_cast<std::uint32_t>(config.max_command_bytes) + packet_headroom_bytes;
+    }
     return o;
 }
 
@@ -122,9 +143,26 @@ public:
         });
     }
 
+    /// Paho thread: a payload above max_payload_bytes was read whole (MQTT 3.1.1, or
+    /// a broker that ignores the Maximum Packet Size). The loop gives the memory back
+    /// once Paho has freed it; one trim for a burst of them.
+    void trim_after_oversize() noexcept {
+        if (trim_pending_.exchange(true)) return;
+        post([](Core& c) {
+            c.trim_timer_.expires_after(trim_delay);
+            c.trim_timer_.async_wait([alive = c.alive_, &c](const asio::error_code& error) {
+                if (error || !*alive) return;  // the Core may be gone: touch nothing
+                c.trim_pending_ = false;
+                release_free_memory();
+            });
+        });
+    }
+
     asio::io_context& io_;
     PahoOptions options_;
     InboundGate inbound_;
+    std::atomic<bool> trim_pending_{false};
+    asio::steady_timer trim_timer_{io_};
     std::atomic<bool> drop_report_pending_{false};
     std::unique_ptr<::mqtt::async_client> client_;
     ClientEvents events_;
@@ -192,6 +230,7 @@ PahoClient::PahoClient(asio::io_context& io, PahoOptions options)
             // An oversized payload is cut: the bridge refuses it by its size alone.
             const auto& whole = message->get_payload();
             payload.assign(whole.data(), std::min(whole.size(), core->options_.max_payload_bytes + 1));
+            if (whole.size() > core->options_.max_payload_bytes) core->trim_after_oversize();
         } catch (...) {
             return;
         }
@@ -237,6 +276,12 @@ void PahoClient::connect() {
         } else {
             options.set_clean_session(o.clean_session);
         }
+        if (o.version == config::MqttVersion::v5 && o.max_packet_bytes > 0) {
+            ::mqtt::properties properties;
+            properties.add(::mqtt::property(::mqtt::property::MAXIMUM_PACKET_SIZE,
+                                            static_cast<int32_t>(o.max_packet_bytes)));
+            options.set_properties(std::move(properties));
+        }
         options.set_connect_timeout(static_cast<int>(o.connect_timeout.count()));
         options.set_automatic_reconnect(false);
         options.set_max_inflight(o.max_inflight);
@@ -279,7 +324,13 @@ std::uint64_t PahoClient::publish(const Message& message) {
 
 void PahoClient::subscribe(const std::string& filter, int qos) {
     try {
-        core_->client_->subscribe(filter, qos, nullptr, core_->subscribe_listener_);
+        // MQTT 5: retain-as-published, so a command published with the retain flag
+        // keeps it on live delivery too and the bridge refuses it (3.1.1 clears the
+        // flag on live delivery: such a command runs once, docs/mqtt.md).
+        const ::mqtt::subscribe_options options(
+            false, core_->options_.version == config::MqttVersion::v5 ? ::mqtt::subscribe_options::RETAIN_AS_PUBLISHED
+                                                                      : ::mqtt::subscribe_options::NO_RETAIN_AS_PUBLISHED);
+        core_->client_->subscribe(filter, qos, nullptr, core_->subscribe_listener_, options);
     } catch (const std::exception&) {
         // Lost the connection meanwhile: subscribed again on the next one.
     }

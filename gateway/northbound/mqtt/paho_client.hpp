@@ -7,6 +7,7 @@
 /// reconnect and no offline buffering in Paho: the bridge owns both.
 // Standard headers before asio's (see daemon/periodic.hpp).
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -37,7 +38,18 @@ struct PahoOptions {
     /// A payload is kept up to this many bytes plus one (enough for the bridge to
     /// see it is too large without holding all of it).
     std::size_t max_payload_bytes = 16 * 1024;
+    /// MQTT 5: the Maximum Packet Size sent on CONNECT; the broker sends no larger
+    /// packet (it drops such a message for this client), so a huge publish on a cmd
+    /// topic never reaches the gateway's memory. 0: none (and never with 3.1.1,
+    /// which has no such property: there only the broker's own limit helps).
+    std::uint32_t max_packet_bytes = 0;
 };
+
+/// Headroom of the Maximum Packet Size over mqtt.max_command_bytes: the longest topic
+/// MQTT allows (65535 bytes and its length), the fixed header, packet identifier and
+/// properties. A payload up to max_command_bytes always gets through, and one a little
+/// larger still gets its `too_large` result.
+inline constexpr std::uint32_t packet_headroom_bytes = 64 * 1024 + 1024;
 
 /// The options of @p config with the will on @p will_topic.
 [[nodiscard]] PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic);

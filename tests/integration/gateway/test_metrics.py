@@ -4,14 +4,16 @@ Modbus TCP traffic shows the line, device, Modbus TCP, upstream, MQTT, reload an
 build families with counters that moved, a transaction-duration histogram whose count
 is the line's transactions, and passes `promtool check metrics` (Debian's
 prometheus package). Also: 404/405, the reload counter, a rebind when the address
-changes on reload, a clear start-up error when the port is taken, and libmicrohttpd
-(with GnuTLS) mapped only once metrics_http is configured."""
+changes on reload, a clear start-up error when the port is taken, libmicrohttpd
+(with GnuTLS) mapped only once metrics_http is configured, and clients that trickle
+header bytes neither hold the endpoint nor stop it for good (issue 24 item 1)."""
 
 import re
 import shutil
 import signal
 import socket
 import subprocess
+import time
 import urllib.error
 import urllib.request
 
@@ -192,6 +194,54 @@ class Metrics(gatewaylib.CellTestCase):
         self.reload("configuration reloaded")
         self.assertIn("fieldbridge_build_info", self.scrape())
         self.assertEqual(self.mapped_libraries("libmicrohttpd", "libgnutls"), {"libmicrohttpd", "libgnutls"})
+
+    def test_trickling_clients_are_cut_and_the_endpoint_serves_again_once_they_left(self):
+        # Issue 24 item 1: 16 connections (4 addresses, 4 each: the per-address bound
+        # lets them all in up to the limit of 8) send one header byte every 3 s for
+        # 15 s. They keep the connections busy, not idle, so only the request-header
+        # deadline (5 s) frees the slots; once they have closed, a scrape is answered.
+        self.start_cell(metrics=True)
+        trickling = []
+        for i in range(16):
+            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            sock.bind(("127.0.0.%d" % (2 + i % 4), 0))
+            sock.connect(("127.0.0.1", self.metrics_port))
+            self.clients.append(sock)
+            trickling.append(sock)
+        header = b"GET /metrics HTTP/1.1\r\nHost: x\r\n"
+        cut = set()
+        started = time.monotonic()
+        for step in range(5):  # 0, 3, 6, 9, 12 s; the last pause ends at 15 s
+            for sock in trickling:
+                if sock in cut:
+                    continue
+                try:
+                    sock.sendall(header[step:step + 1])
+                except OSError:
+                    cut.add(sock)
+            pause_end = started + 3.0 * (step + 1)
+            while time.monotonic() < pause_end:
+                for sock in trickling:
+                    if sock not in cut and gatewaylib.closed_by_server(sock, timeout=0.01):
+                        cut.add(sock)
+                time.sleep(0.1)
+        self.assertEqual(len(cut), 16, "trickling connections still open after 15 s")
+        for sock in trickling:
+            sock.close()
+        # Served again at once (bounded: the scrape's own 5 s timeout).
+        self.assertIn("fieldbridge_build_info", self.scrape())
+        self.assertIn("fieldbridge_build_info", self.scrape())
+
+    def test_one_address_cannot_take_every_connection(self):
+        self.start_cell(metrics=True)
+        for _ in range(16):
+            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            sock.bind(("127.0.0.2", 0))
+            sock.connect(("127.0.0.1", self.metrics_port))
+            sock.sendall(b"G")
+            self.clients.append(sock)
+        # A scrape from another address while they hold what they were given.
+        self.assertIn("fieldbridge_build_info", self.scrape())
 
     # -- helpers ---------------------------------------------------------------------
 

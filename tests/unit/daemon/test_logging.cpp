@@ -83,6 +83,20 @@ TEST_CASE("the human format carries time and level, and no priority prefix") {
     CHECK_FALSE(matches_shape("2024-01-01 12:00:00.123 [warning] x\n", "9999-99-99 99:99:99.999 [warning] y\n"));
 }
 
+TEST_CASE("a message carrying control characters stays one line in both formats (issue 24 item 4)") {
+    // As the MQTT bridge logged an op from a command: the op is from outside.
+    const std::string op = "x\n2026-01-01 00:00:00.000 [critical] FORGED\x1b[2J";
+    for (const auto format : {LogFormat::journal, LogFormat::human}) {
+        Captured log(format);
+        log.logger->warn("MQTT: command 1 '{}' to gripper-1: unknown_op", op);
+        const std::string text = log.text.str();
+        CHECK(text.find('\n') == text.size() - 1);  // the line's own end only
+        CHECK(text.find('\x1b') == std::string::npos);
+        CHECK(text.find("'x\\n2026-01-01 00:00:00.000 [critical] FORGED\\x1B[2J' to gripper-1") !=
+              std::string::npos);
+    }
+}
+
 TEST_CASE("the log level filters messages") {
     Captured log(LogFormat::journal);
     log.logger->set_level(daemon_ns::to_spdlog_level(LogLevel::warning));
