@@ -14,6 +14,7 @@ import threading
 import time
 
 import devserverlib
+import emulation
 import gatewaylib
 import simlib
 
@@ -257,13 +258,14 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         server = devserverlib.DeviceServer(self.path("line-a"))
         self.addCleanup(server.close)
         port = "tcp://127.0.0.1:%d" % server.port
-        result = subprocess.run([gatewaylib.GATEWAY, "scan", "--port", port, "--from", "1", "--to", "6"],
-                                capture_output=True, text=True, timeout=60)
+        result = subprocess.run(emulation.target_command(gatewaylib.GATEWAY, "scan", "--port", port, "--from", "1",
+                                                         "--to", "6"), capture_output=True, text=True, timeout=60)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertIn("port: " + port, result.stdout)
         for kind in ("hiwin-xeg", "excd203mb", "wtec-ascii"):
             self.assertIn(kind, result.stdout)
-        refused = subprocess.run([gatewaylib.GATEWAY, "scan", "--port", "tcp://127.0.0.1:%d" % gatewaylib.free_port()],
+        refused = subprocess.run(emulation.target_command(gatewaylib.GATEWAY, "scan", "--port",
+                                                          "tcp://127.0.0.1:%d" % gatewaylib.free_port()),
                                  capture_output=True, text=True, timeout=60)
         self.assertNotEqual(refused.returncode, 0)
         self.assertIn("Connection refused", refused.stderr)
@@ -277,8 +279,8 @@ class DeviceServerConfig(gatewaylib.CellTestCase):
         with open(path, "w", encoding="utf-8") as f:
             f.write("gateway: {id: c}\nlines:\n  - name: a\n    port: %s\n%s    devices:\n"
                     "      - {name: d, type: hiwin-xeg, address: 1, unit_id: 1}\n" % (port, line_keys))
-        return subprocess.run([gatewaylib.GATEWAY, "--check-config", path], capture_output=True, text=True,
-                              timeout=30)
+        return subprocess.run(emulation.target_command(gatewaylib.GATEWAY, "--check-config", path),
+                              capture_output=True, text=True, timeout=30)
 
     def test_serial_only_options_and_unresolvable_hosts_are_errors(self):
         self.assertEqual(self.check("").returncode, 0)
