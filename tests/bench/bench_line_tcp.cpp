@@ -39,7 +39,7 @@ namespace {
 
 using namespace fieldbridge;
 using integration::EngineHarness;
-using integration::SimProcess;
+using test::SimProcess;
 using Clock = std::chrono::steady_clock;
 using std::chrono::duration;
 using std::chrono::milliseconds;
