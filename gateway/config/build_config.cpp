@@ -74,6 +74,7 @@ void set(T& target, const Field<T>& field) {
     DeviceConfig device;
     device.name = *raw.name;
     device.type = *raw.type;
+    device.type_name = std::string{core::to_string(device.type)};
     device.address = core::BusAddress{static_cast<std::uint8_t>(*raw.address)};
     device.unit_id = core::UnitId{static_cast<std::uint8_t>(*raw.unit_id)};
     set(device.max_age, raw.max_age);

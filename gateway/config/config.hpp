@@ -23,6 +23,7 @@
 #include "core/log_level.hpp"
 #include "core/modbus_ids.hpp"
 #include "core/parity.hpp"
+#include "core/point.hpp"
 #include "core/register_table.hpp"
 #include "core/word_order.hpp"
 
@@ -196,6 +197,13 @@ struct DeviceConfig {
     std::optional<std::uint32_t> stroke;        ///< wtec-ascii only, required there
     static constexpr Range<std::int64_t> stroke_range{1, 0x7FFF'FFFF};
     std::vector<RegisterBlock> blocks;          ///< modbus only, required there
+    /// `type:` as written: a built-in type's name, or a device definition's name
+    /// (then `type` is DeviceType::modbus and `definition_file` says where it came from).
+    std::string type_name;
+    std::string definition_file;                ///< "" for built-in types
+    /// Points and alarms (the definition's, then the inline ones) and `max_gap`;
+    /// empty for the built-in types.
+    core::PointModel points;
     bool operator==(const DeviceConfig&) const = default;
 };
 

@@ -85,6 +85,7 @@ ProfileOptions profile_options(const config::DeviceConfig& device) {
         options.blocks.push_back(GenericBlock{block.table, block.address, block.count, block.period,
                                               block.writable});
     }
+    options.points = device.points;
     return options;
 }
 

@@ -24,6 +24,7 @@
 #include "core/device_type.hpp"
 #include "core/error.hpp"
 #include "core/modbus_ids.hpp"
+#include "core/point.hpp"
 #include "core/word_order.hpp"
 #include "engine/profiles/operations.hpp"
 #include "engine/profiles/poll_plan.hpp"
@@ -68,7 +69,8 @@ struct ProfileOptions {
     bool allow_protected = false;                  ///< device ID / flash save / baud / mode writes
     WordOrder word_order = WordOrder::high_first;  ///< excd203mb
     std::optional<std::uint32_t> wtec_stroke;      ///< wtec-ascii: encoder counts for 100 %; required
-    std::vector<GenericBlock> blocks;              ///< modbus: required
+    std::vector<GenericBlock> blocks;              ///< modbus: raw blocks (with points: optional)
+    core::PointModel points;                       ///< modbus: named, typed points and their alarms
 };
 
 /// Options a profile cannot work with; what() names the option and the fix.
