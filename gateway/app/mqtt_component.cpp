@@ -23,6 +23,8 @@ MqttComponent::MqttComponent(asio::io_context& io, std::shared_ptr<spdlog::logge
 
 MqttComponent::~MqttComponent() {
     *alive_ = false;
+    // Destroyed as the process ends (main's last scope): see leave_to_process_exit().
+    if (bridge_) bridge_->leave_client_to_process_exit();
     bridge_.reset();
     // The engine may already be gone (stopped after us): never touch the agents.
     detach_sources();

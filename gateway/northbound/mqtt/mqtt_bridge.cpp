@@ -146,6 +146,7 @@ public:
     }
 
     [[nodiscard]] bool connected() const noexcept { return client_->connected(); }
+    void leave_client_to_process_exit() noexcept { client_->leave_to_process_exit(); }
 
     [[nodiscard]] BridgeStats stats() const {
         BridgeStats s = stats_;
@@ -575,6 +576,7 @@ void Bridge::set_sources(std::vector<std::shared_ptr<DeviceSource>> sources) { i
 void Bridge::set_diag_provider(DiagProvider provider) { impl_->diag_ = std::move(provider); }
 void Bridge::start() { impl_->start(); }
 void Bridge::stop(std::function<void()> done) { impl_->stop(std::move(done)); }
+void Bridge::leave_client_to_process_exit() noexcept { impl_->leave_client_to_process_exit(); }
 bool Bridge::connected() const noexcept { return impl_->connected(); }
 BridgeStats Bridge::stats() const { return impl_->stats(); }
 const BridgeSettings& Bridge::settings() const noexcept { return impl_->settings(); }

@@ -114,6 +114,8 @@ public:
     void stop(std::function<void()> done);
 
     [[nodiscard]] bool connected() const noexcept;
+    /// The process ends after this bridge: see Client::leave_to_process_exit().
+    void leave_client_to_process_exit() noexcept;
     [[nodiscard]] BridgeStats stats() const;
     [[nodiscard]] const BridgeSettings& settings() const noexcept;
 

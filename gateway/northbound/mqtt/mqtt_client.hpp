@@ -51,6 +51,10 @@ public:
     /// @p done runs on the loop thread afterwards, whatever happened.
     virtual void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) = 0;
     [[nodiscard]] virtual bool connected() const = 0;
+    /// The process is ending: a client that is not connected may leave its library
+    /// state to the process exit instead of tearing it down in its destructor
+    /// (PahoClient: paho.mqtt.c's last-client teardown races its worker threads).
+    virtual void leave_to_process_exit() noexcept {}
 };
 
 }  // namespace fieldbridge::northbound::mqtt

@@ -59,6 +59,7 @@ public:
     /// Throws std::runtime_error naming the URI when Paho refuses it.
     PahoClient(asio::io_context& io, PahoOptions options);
     ~PahoClient() override;
+    void leave_to_process_exit() noexcept override { leave_to_exit_ = true; }
 
     void set_events(ClientEvents events) override;
     void connect() override;
@@ -71,6 +72,7 @@ public:
 
 private:
     std::shared_ptr<Core> core_;
+    bool leave_to_exit_ = false;
 };
 
 }  // namespace fieldbridge::northbound::mqtt

@@ -36,6 +36,8 @@ GATEWAY = None  # path of the fieldbridge binary, from --gateway
 # Generous bounds for a loaded 2-core machine and sanitizer builds.
 START_TIMEOUT = 30.0
 STOP_TIMEOUT = 10.0
+# How long a sanitizer report may take to be written out before the process is killed.
+SANITIZER_REPORT_TIMEOUT = 60.0
 IO_TIMEOUT = 5.0
 # mosquitto's default log types, plus each subscription (subscribe() waits for it).
 BROKER_LOG_TYPES = ("log_type error\nlog_type warning\nlog_type notice\nlog_type information\n"
@@ -354,7 +356,16 @@ class CellTestCase(unittest.TestCase):
                     if code != 0:
                         unclean.append("fieldbridge exited with %d after SIGTERM" % code)
                 except subprocess.TimeoutExpired:
-                    unclean.append("fieldbridge ignored SIGTERM for %.0f s" % STOP_TIMEOUT)
+                    if "Sanitizer" in _read(process.log_path):
+                        # A sanitizer report is being written (symbolising takes long on a
+                        # loaded machine): let it finish, so that the log shows the stack.
+                        try:
+                            process.wait_exit(SANITIZER_REPORT_TIMEOUT)
+                        except subprocess.TimeoutExpired:
+                            pass
+                        unclean.append("fieldbridge failed a sanitizer check while stopping (its log below)")
+                    else:
+                        unclean.append("fieldbridge ignored SIGTERM for %.0f s" % STOP_TIMEOUT)
             process.kill()
             if failed or unclean:
                 sys.stderr.write("---- %s log ----\n%s\n" % (process.name, _read(process.log_path)))
