@@ -2,7 +2,8 @@
 /// @file unit_target.hpp
 /// What a Modbus TCP unit ID leads to (spec §4): a serial device (its DeviceAgent), a
 /// line's broadcast unit, or a unit of an upstream Modbus TCP server (Huacheng R6
-/// pass-through). The server decodes MBAP, applies access control, answers a function
+/// pass-through). The server decodes MBAP and the PDU (once: RequestPdu), applies
+/// access control on the typed request, answers a function
 /// byte of 0 or >= 0x80 itself (exception 0x01, protocol/gateway_exceptions.hpp), and
 /// hands any other PDU to the target of the unit; the target answers with a response PDU (normal or
 /// exception) through the handler, exactly once, on the loop thread, never from
@@ -10,9 +11,11 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <utility>
 
 #include "config/net_address.hpp"
 #include "core/modbus_ids.hpp"
+#include "northbound/request_pdu.hpp"
 #include "protocol/bytes.hpp"
 
 namespace fieldbridge::northbound {
@@ -34,9 +37,12 @@ public:
     UnitTarget(const UnitTarget&) = delete;
     UnitTarget& operator=(const UnitTarget&) = delete;
 
-    /// @p request_pdu is a complete PDU as received (function code first).
-    virtual void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
-                        PduHandler done) = 0;
+    /// @p request: a complete PDU as received and decoded once by the server.
+    virtual void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) = 0;
+    /// The same for PDU bytes (tests, tools): decodes them, then handle() above.
+    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client, PduHandler done) {
+        handle(unit, RequestPdu::decode(request_pdu), client, std::move(done));
+    }
     /// Units whose access rules this target's requests must pass too, besides its own
     /// unit: a line's broadcast unit reaches every unit of its line.
     [[nodiscard]] virtual std::span<const core::UnitId> ruled_as() const noexcept { return {}; }

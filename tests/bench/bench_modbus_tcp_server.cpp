@@ -40,7 +40,8 @@ public:
         response_ = protocol::encode_response(
             protocol::ReadRegistersResponse{0x03, std::vector<std::uint16_t>(registers, 0x1234)});
     }
-    void handle(core::UnitId, protocol::ByteView, const northbound::ClientRef&, northbound::PduHandler done) override {
+    void handle(core::UnitId, const northbound::RequestPdu&, const northbound::ClientRef&,
+                northbound::PduHandler done) override {
         asio::post(io_, [this, done = std::move(done)] { done(response_); });
     }
 

@@ -3,6 +3,8 @@
 #include "northbound/modbus_tcp/access_control.hpp"
 
 #include <algorithm>
+#include <type_traits>
+#include <variant>
 
 #include "protocol/modbus_pdu.hpp"
 
@@ -79,6 +81,36 @@ RequestScope request_scope(protocol::ByteView pdu) noexcept {
     // A PDU too short for its address fields, or a function code whose registers
     // the server does not derive: it may touch any register.
     if (!scope.first) scope.first = every_register;
+    return scope;
+}
+
+RequestScope request_scope(const RequestPdu& request) noexcept {
+    if (!request.decoded.complete()) return request_scope(request.bytes);
+    RequestScope scope;
+    scope.function = request.function();
+    std::visit(
+        [&](const auto& r) {
+            using R = std::decay_t<decltype(r)>;
+            if constexpr (std::is_same_v<R, protocol::ReadBitsRequest> || std::is_same_v<R, protocol::ReadRegistersRequest>) {
+                scope.first = span(r.address, r.count);
+            } else if constexpr (std::is_same_v<R, protocol::WriteSingleCoilRequest> ||
+                                 std::is_same_v<R, protocol::WriteSingleRegisterRequest> ||
+                                 std::is_same_v<R, protocol::MaskWriteRegisterRequest>) {
+                scope.first = span(r.address, 1);
+            } else if constexpr (std::is_same_v<R, protocol::WriteMultipleCoilsRequest> ||
+                                 std::is_same_v<R, protocol::WriteMultipleRegistersRequest>) {
+                scope.first = span(r.address, static_cast<std::uint16_t>(r.values.size()));
+            } else if constexpr (std::is_same_v<R, protocol::ReadWriteRegistersRequest>) {
+                scope.first = span(r.read_address, r.read_count);
+                scope.second = span(r.write_address, static_cast<std::uint16_t>(r.values.size()));
+            } else if constexpr (std::is_same_v<R, protocol::ReadExceptionStatusRequest>) {
+                // reads no register
+            } else {
+                // Opaque: FC0B, 0C, 11 touch nothing; anything else may touch everything.
+                if (!touches_no_register(scope.function)) scope.first = every_register;
+            }
+        },
+        request.decoded.value);
     return scope;
 }
 

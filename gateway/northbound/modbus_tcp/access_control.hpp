@@ -1,8 +1,9 @@
 #pragma once
 /// @file access_control.hpp
 /// Per-request access control of the Modbus TCP server (spec section 4): what a
-/// request touches (function code and address ranges, read straight from the PDU's
-/// header fields) and whether the configured rules let the client do it.
+/// request touches (function code and address ranges, from the decoded request, or
+/// straight from the PDU's header fields when it does not decode) and whether the
+/// configured rules let the client do it.
 ///
 /// Pure: no I/O, no state. The PDU is not validated here. Rules fail closed: a
 /// request whose registers the server cannot derive (a PDU too short for its address
@@ -15,6 +16,7 @@
 
 #include "config/config.hpp"
 #include "core/modbus_ids.hpp"
+#include "northbound/request_pdu.hpp"
 #include "protocol/bytes.hpp"
 
 namespace fieldbridge::northbound::modbus_tcp {
@@ -34,6 +36,11 @@ struct RequestScope {
 /// as the one addressed register and a range running past 0xFFFF ends at 0xFFFF, so
 /// a malformed quantity can never make a request look smaller than what it names.
 [[nodiscard]] RequestScope request_scope(protocol::ByteView pdu) noexcept;
+
+/// The scope of a request the server decoded once (RequestPdu): from the typed
+/// request when it decoded, from the header bytes (above) when it did not, so a
+/// malformed PDU still fails closed. Both give the same scope for a well-formed PDU.
+[[nodiscard]] RequestScope request_scope(const RequestPdu& request) noexcept;
 
 /// The allow-list is checked at accept (ModbusTcpConfig::client_allowed); this is
 /// the per-request rule check: the first matching rule decides, no match allows.

@@ -201,7 +201,9 @@ void Connection::finish_draining() {
 void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, protocol::ByteView pdu) {
     ConnectionContext& context = *context_;
     ++context.stats.requests;
-    const RequestScope scope = request_scope(pdu);
+    // Decoded once: the rules, the target and the device's profile read this.
+    const RequestPdu request = RequestPdu::decode(pdu);
+    const RequestScope scope = request_scope(request);
     const core::FunctionCode function = scope.function;
     UnitTarget* target = context.routes.find(unit);
     // A broadcast unit answers for the units of its line: a request it may carry
@@ -246,7 +248,7 @@ void Connection::dispatch(std::uint16_t transaction_id, core::UnitId unit, proto
     try {
         // The handler keeps this connection (not its socket: close() releases that)
         // so that an answer arriving after the close is counted and dropped here.
-        target->handle(unit, pdu, client_,
+        target->handle(unit, request, client_,
                        [self = shared_from_this(), index, generation](protocol::Bytes response) {
                            self->complete(index, generation, std::move(response));
                        });

@@ -123,14 +123,14 @@ std::vector<engine::Duration> LineBroadcastTarget::line_time(const std::vector<B
     return costs;
 }
 
-void LineBroadcastTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
+void LineBroadcastTarget::handle(core::UnitId /*unit*/, const RequestPdu& request, const ClientRef& /*client*/,
                                  PduHandler done) {
     asio::io_context& io = shared_->io;
     auto op = std::make_shared<Operation>();
-    op->function = protocol::pdu_function(request_pdu);
+    op->function = request.function();
     op->waiting.push_back(std::move(done));
     const auto refuse = [&](const protocol::Bytes& pdu) { op->answer(io, pdu); };
-    const auto decoded = protocol::decode_request(request_pdu);
+    const auto& decoded = request.decoded;
     if (!decoded.complete()) {
         refuse(protocol::exception_pdu(op->function, protocol::refusal_for_undecodable(op->function)));
         return;

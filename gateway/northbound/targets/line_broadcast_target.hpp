@@ -64,8 +64,8 @@ public:
                         BroadcastSettings settings);
     ~LineBroadcastTarget() override;
 
-    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
-                PduHandler done) override;
+    using UnitTarget::handle;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
     [[nodiscard]] std::span<const core::UnitId> ruled_as() const noexcept override { return units_; }
 
 private:

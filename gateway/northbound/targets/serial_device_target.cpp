@@ -16,10 +16,10 @@ void SerialDeviceTarget::answer(PduHandler done, protocol::Bytes pdu) {
     asio::post(io_, [done = std::move(done), pdu = std::move(pdu)]() mutable { done(std::move(pdu)); });
 }
 
-void SerialDeviceTarget::handle(core::UnitId /*unit*/, protocol::ByteView request_pdu, const ClientRef& /*client*/,
+void SerialDeviceTarget::handle(core::UnitId /*unit*/, const RequestPdu& request, const ClientRef& /*client*/,
                                 PduHandler done) {
-    const auto decoded = protocol::decode_request(request_pdu);
-    const core::FunctionCode function = protocol::pdu_function(request_pdu);
+    const auto& decoded = request.decoded;
+    const core::FunctionCode function = request.function();
     if (!decoded.complete()) {
         answer(std::move(done), protocol::exception_pdu(function, protocol::refusal_for_undecodable(function)));
         return;

@@ -23,8 +23,8 @@ public:
     /// routes before rebuilding the engine).
     SerialDeviceTarget(asio::io_context& io, engine::DeviceAgent& agent, const engine::LineWorker& line);
 
-    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
-                PduHandler done) override;
+    using UnitTarget::handle;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
 
 private:
     void answer(PduHandler done, protocol::Bytes pdu);

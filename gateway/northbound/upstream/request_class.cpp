@@ -37,9 +37,10 @@ bool RequestClass::touches_any() const noexcept {
     return false;
 }
 
-Classified classify(protocol::ByteView pdu) {
+Classified classify(protocol::ByteView pdu) { return classify(protocol::decode_request(pdu), pdu); }
+
+Classified classify(const protocol::DecodeResult<protocol::Request>& decoded, protocol::ByteView pdu) {
     Classified out;
-    const auto decoded = protocol::decode_request(pdu);
     if (!decoded.complete()) {
         out.local.refusal = protocol::refusal_for_undecodable(protocol::pdu_function(pdu));
         return out;

@@ -13,7 +13,9 @@
 #include "engine/transaction.hpp"
 #include "northbound/upstream/r6_sequences.hpp"
 #include "protocol/bytes.hpp"
+#include "protocol/decode_result.hpp"
 #include "protocol/gateway_exceptions.hpp"
+#include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::northbound::upstream {
 
@@ -44,5 +46,7 @@ struct Classified {
     LocalAnswer local;
 };
 [[nodiscard]] Classified classify(protocol::ByteView pdu);
+/// The same for a request already decoded (the server decodes each PDU once).
+[[nodiscard]] Classified classify(const protocol::DecodeResult<protocol::Request>& decoded, protocol::ByteView pdu);
 
 }  // namespace fieldbridge::northbound::upstream

@@ -104,15 +104,16 @@ public:
         }
     }
 
-    void handle(core::UnitId unit_id, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
+    void handle(core::UnitId unit_id, const RequestPdu& request, const ClientRef& client, PduHandler done) {
         ++stats_.requests;
-        const core::FunctionCode function = protocol::pdu_function(pdu);
+        const protocol::ByteView pdu = request.bytes;
+        const core::FunctionCode function = request.function();
         const Unit* unit = find(unit_id);
         if (unit == nullptr || !started_) {
             answer_later(std::move(done), exception_pdu(function, GatewayRefusal::path_down));
             return;
         }
-        const Classified classified = classify(pdu);
+        const Classified classified = classify(request.decoded, pdu);
         if (!classified.request) {
             answer_later(std::move(done), exception_pdu(function, classified.local.refusal));
             return;
@@ -123,13 +124,16 @@ public:
             answer_later(std::move(done), exception_pdu(function, GatewayRefusal::path_down));
             return;
         }
-        UpstreamRequest request;
-        request.client = client.connection;
-        request.unit = unit->config.upstream_unit;
-        request.pdu.assign(pdu.begin(), pdu.end());
-        request.request_class = *classified.request;
-        request.done = [weak = weak_from_this(), done = std::move(done), function, unit_id,
-                        asked = request.pdu](const UpstreamOutcome& outcome) {
+        // The client's request as decoded by the server, to check the reply against.
+        std::optional<protocol::Request> asked;
+        if (request.decoded.complete()) asked = request.decoded.value;
+        UpstreamRequest upstream;
+        upstream.client = client.connection;
+        upstream.unit = unit->config.upstream_unit;
+        upstream.pdu.assign(pdu.begin(), pdu.end());
+        upstream.request_class = *classified.request;
+        upstream.done = [weak = weak_from_this(), done = std::move(done), function, unit_id,
+                         asked = std::move(asked)](const UpstreamOutcome& outcome) {
             const auto self = weak.lock();
             if (self && outcome.status == UpstreamStatus::ok) {
                 if (self->reply_malformed(unit_id, asked, outcome.response_pdu)) {
@@ -139,7 +143,7 @@ public:
             }
             done(answer_pdu(function, outcome));
         };
-        scheduler_.submit(std::move(request), Clock::now());
+        scheduler_.submit(std::move(upstream), Clock::now());
         pump();
     }
 
@@ -147,18 +151,17 @@ public:
     /// A reply that does not fit its request (an exception of another length than 2,
     /// another quantity, a byte count its data does not match, another echo of a
     /// write) never reaches the client: it would read garbage as data.
-    [[nodiscard]] bool reply_malformed(core::UnitId unit_id, const protocol::Bytes& asked,
+    [[nodiscard]] bool reply_malformed(core::UnitId unit_id, const std::optional<protocol::Request>& asked,
                                        const protocol::Bytes& reply) {
-        const auto request = protocol::decode_request(asked);
-        if (!request.complete()) return false;  // the client's own business (it was forwarded as it came)
-        const auto decoded = protocol::decode_response(reply, request.value);
+        if (!asked) return false;  // the client's own business (it was forwarded as it came)
+        const auto decoded = protocol::decode_response(reply, *asked);
         if (!decoded.malformed()) return false;
         ++stats_.malformed_replies;
         if (log_.enabled(engine::LogLevel::warning)) {
             log_(engine::LogLevel::warning,
                  fmt::format("upstream {}: unit {} sent a malformed reply to function 0x{:02X} ({}; {} bytes, "
                              "first 0x{:02X}); the client gets exception 0x04, nothing of it is passed on",
-                             config_.name, unit_id.value, protocol::pdu_function(asked).value,
+                             config_.name, unit_id.value, protocol::function_code(*asked).value,
                              protocol::to_string(decoded.error), reply.size(), protocol::pdu_function(reply).value));
         }
         return true;
@@ -448,9 +451,9 @@ UpstreamTarget::~UpstreamTarget() {
 void UpstreamTarget::start() { impl_->start(); }
 void UpstreamTarget::stop() { impl_->stop(); }
 
-void UpstreamTarget::handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
+void UpstreamTarget::handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client,
                             PduHandler done) {
-    impl_->handle(unit, request_pdu, client, std::move(done));
+    impl_->handle(unit, request, client, std::move(done));
 }
 
 void UpstreamTarget::client_closed(std::uint64_t connection) { impl_->client_closed(connection); }

@@ -90,8 +90,8 @@ public:
     /// Closes the connection, answers everything outstanding 0x0A. Idempotent.
     void stop();
 
-    void handle(core::UnitId unit, protocol::ByteView request_pdu, const ClientRef& client,
-                PduHandler done) override;
+    using UnitTarget::handle;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
     void client_closed(std::uint64_t connection) override;
 
     void set_state_callback(R6StateCallback callback);

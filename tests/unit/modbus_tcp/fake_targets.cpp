@@ -6,12 +6,14 @@
 
 namespace fieldbridge::northbound::modbus_tcp::test {
 
-void ImmediateTarget::handle(core::UnitId /*unit*/, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
+void ImmediateTarget::handle(core::UnitId /*unit*/, const RequestPdu& request, const ClientRef& client, PduHandler done) {
+    const protocol::ByteView pdu = request.bytes;
     record(pdu, client);
     asio::post(io_, [done = std::move(done), answer = bank.answer(pdu)]() mutable { done(std::move(answer)); });
 }
 
-void DelayedTarget::handle(core::UnitId /*unit*/, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
+void DelayedTarget::handle(core::UnitId /*unit*/, const RequestPdu& request, const ClientRef& client, PduHandler done) {
+    const protocol::ByteView pdu = request.bytes;
     record(pdu, client);
     const auto delay = pdu.size() >= 3 ? std::chrono::milliseconds{protocol::get_u16_be(pdu, 1)} : std::chrono::milliseconds{0};
     pending_.push_back(Pending{asio::steady_timer(io_, delay), client.connection});
@@ -36,7 +38,8 @@ void DelayedTarget::client_closed(std::uint64_t connection) {
     }
 }
 
-void SilentTarget::handle(core::UnitId /*unit*/, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
+void SilentTarget::handle(core::UnitId /*unit*/, const RequestPdu& request, const ClientRef& client, PduHandler done) {
+    const protocol::ByteView pdu = request.bytes;
     record(pdu, client);
     held_.push_back(Held{client.connection, protocol::Bytes(pdu.begin(), pdu.end()), std::move(done)});
 }
@@ -53,7 +56,8 @@ std::size_t SilentTarget::answer_all() {
     return held.size();
 }
 
-void EmptyAnswerTarget::handle(core::UnitId /*unit*/, protocol::ByteView pdu, const ClientRef& client, PduHandler done) {
+void EmptyAnswerTarget::handle(core::UnitId /*unit*/, const RequestPdu& request, const ClientRef& client, PduHandler done) {
+    const protocol::ByteView pdu = request.bytes;
     record(pdu, client);
     asio::post(io_, [done = std::move(done)]() mutable { done(protocol::Bytes{}); });
 }

@@ -17,6 +17,7 @@ namespace fieldbridge::northbound::modbus_tcp::test {
 /// What every fake records.
 class RecordingTarget : public UnitTarget {
 public:
+    using UnitTarget::handle;
     void client_closed(std::uint64_t connection) override { closed.push_back(connection); }
     std::vector<protocol::Bytes> seen;        ///< request PDUs, in arrival order
     std::vector<std::uint64_t> closed;        ///< client_closed calls
@@ -32,7 +33,7 @@ protected:
 class ImmediateTarget final : public RecordingTarget {
 public:
     explicit ImmediateTarget(asio::io_context& io) : io_(io) {}
-    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
     RegisterBank bank;
 private:
     asio::io_context& io_;
@@ -44,7 +45,7 @@ class DelayedTarget final : public RecordingTarget {
 public:
     /// @p answer_closed: also answer requests whose connection closed (a late answer).
     DelayedTarget(asio::io_context& io, bool answer_closed = false) : io_(io), answer_closed_(answer_closed) {}
-    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
     void client_closed(std::uint64_t connection) override;
     RegisterBank bank;
 private:
@@ -61,7 +62,7 @@ private:
 class SilentTarget final : public RecordingTarget {
 public:
     explicit SilentTarget(asio::io_context& /*io*/) {}
-    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
     void client_closed(std::uint64_t connection) override;
     /// Answers everything held, from the bank; returns how many.
     std::size_t answer_all();
@@ -80,7 +81,8 @@ private:
 class ThrowingTarget final : public RecordingTarget {
 public:
     explicit ThrowingTarget(asio::io_context& /*io*/) {}
-    void handle(core::UnitId, protocol::ByteView pdu, const ClientRef& client, PduHandler) override {
+    void handle(core::UnitId, const RequestPdu& request, const ClientRef& client, PduHandler) override {
+        const protocol::ByteView pdu = request.bytes;
         record(pdu, client);
         throw std::runtime_error("fake target failure");
     }
@@ -90,7 +92,7 @@ public:
 class EmptyAnswerTarget final : public RecordingTarget {
 public:
     explicit EmptyAnswerTarget(asio::io_context& io) : io_(io) {}
-    void handle(core::UnitId unit, protocol::ByteView pdu, const ClientRef& client, PduHandler done) override;
+    void handle(core::UnitId unit, const RequestPdu& request, const ClientRef& client, PduHandler done) override;
 private:
     asio::io_context& io_;
 };

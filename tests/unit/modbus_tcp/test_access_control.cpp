@@ -61,6 +61,38 @@ TEST_CASE("request_scope: a malformed quantity never shrinks the range") {
     CHECK(request_scope(Bytes{0x10, 0xFF, 0xFE, 0x00, 0x7B}) == RequestScope{FunctionCode{0x10}, RegisterRange{0xFFFE, 0xFFFF}, {}});
 }
 
+TEST_CASE("request_scope of a decoded request: the same scope as the header bytes, which malformed PDUs keep") {
+    // The server decodes each PDU once (RequestPdu); the rules read the typed request.
+    const std::vector<Bytes> well_formed{
+        Bytes{0x01, 0x00, 0x10, 0x00, 0x08},
+        Bytes{0x02, 0x00, 0x00, 0x00, 0x01},
+        Bytes{0x03, 0x01, 0x00, 0x00, 0x7D},
+        Bytes{0x04, 0x03, 0x00, 0x00, 0x02},
+        Bytes{0x05, 0x00, 0x07, 0xFF, 0x00},
+        Bytes{0x06, 0x01, 0x02, 0x00, 0x01},
+        Bytes{0x07},
+        Bytes{0x0F, 0x00, 0x13, 0x00, 0x0A, 0x02, 0xCD, 0x01},
+        Bytes{0x10, 0x00, 0x01, 0x00, 0x02, 0x04, 0x00, 0x0A, 0x01, 0x02},
+        Bytes{0x16, 0x00, 0x04, 0x00, 0xF2, 0x00, 0x25},
+        Bytes{0x17, 0x00, 0x03, 0x00, 0x06, 0x00, 0x0E, 0x00, 0x03, 0x06, 0, 0xFF, 0, 0xFF, 0, 0xFF},
+        Bytes{0x11},
+        Bytes{0x08, 0x00, 0x00, 0xA5, 0x37},
+        Bytes{0x2B, 0x0E, 0x01, 0x00},
+    };
+    for (const Bytes& pdu : well_formed) {
+        CAPTURE(static_cast<int>(pdu[0]));
+        const RequestPdu request = RequestPdu::decode(pdu);
+        REQUIRE(request.decoded.complete());
+        CHECK(request_scope(request) == request_scope(pdu));
+    }
+    // A write whose byte count does not match: not decoded, the header bytes still name
+    // its range (and a deny rule over it still matches).
+    const Bytes malformed{0x10, 0x00, 0x20, 0x00, 0x02, 0x03, 0x00, 0x01};
+    const RequestPdu request = RequestPdu::decode(malformed);
+    CHECK_FALSE(request.decoded.complete());
+    CHECK(request_scope(request) == RequestScope{FunctionCode{0x10}, RegisterRange{0x20, 0x21}, {}});
+}
+
 TEST_CASE("request_allowed: first matching rule decides, FC17 needs both ranges allowed") {
     config::ModbusTcpConfig config;
     CHECK(request_allowed(config, ip("10.0.0.1"), UnitId{1}, request_scope(Bytes{0x06, 0, 1, 0, 1})));  // no rules
