@@ -158,7 +158,7 @@ void LineBroadcastTarget::handle(core::UnitId /*unit*/, const RequestPdu& reques
     op->stop = std::all_of(plan.steps.begin(), plan.steps.end(), [](const BroadcastStep& step) { return step.urgent; });
     op->step_costs = line_time(plan.steps);
     op->request = decoded.value;
-    op->request_pdu.assign(request_pdu.begin(), request_pdu.end());
+    op->request_pdu.assign(request.bytes.begin(), request.bytes.end());
     op->steps = std::move(plan.steps);
     op->echo = protocol::encode_response(*echo);
     if (op->stop) {
