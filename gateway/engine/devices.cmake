@@ -1,7 +1,9 @@
-# Register image and device profiles (XEG, EXCD203MB, WTEC RTU, WTEC ASCII view,
+# Register image, point codec (points/) and device profiles (XEG, EXCD203MB, WTEC RTU, WTEC ASCII view,
 # generic Modbus). Pure logic over the protocol codecs: no I/O, no clock.
 add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/register_image.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/points/point_codec.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/points/point_requests.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/device_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/operations.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
