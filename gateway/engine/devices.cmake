@@ -4,6 +4,7 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/register_image.cpp
   ${CMAKE_CURRENT_LIST_DIR}/points/point_codec.cpp
   ${CMAKE_CURRENT_LIST_DIR}/points/point_requests.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/points/point_alarms.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/device_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/operations.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
@@ -15,6 +16,7 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_rtu_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_ascii_image.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_ascii_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/generic_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/generic_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/profile_factory.cpp
 )

@@ -20,7 +20,7 @@ using std::chrono::milliseconds;
 
 PollUnit unit(std::uint16_t address, std::uint16_t count, PollClass c = PollClass::fast,
               fe::Duration period = milliseconds{50}, Table table = Table::holding) {
-    return PollUnit{RegisterSpan{table, address, count}, c, period, false};
+    return PollUnit{RegisterSpan{table, address, count}, c, period, false, 0};
 }
 
 fp::ReadRegistersRequest read_of(const fe::PollItem& item) {
