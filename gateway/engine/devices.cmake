@@ -1,7 +1,10 @@
-# Register image and device profiles (XEG, EXCD203MB, WTEC RTU, WTEC ASCII view,
+# Register image, point codec (points/) and device profiles (XEG, EXCD203MB, WTEC RTU, WTEC ASCII view,
 # generic Modbus). Pure logic over the protocol codecs: no I/O, no clock.
 add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/register_image.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/points/point_codec.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/points/point_requests.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/points/point_alarms.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/device_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/operations.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
@@ -13,6 +16,7 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_rtu_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_ascii_image.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_ascii_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/generic_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/generic_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/profile_factory.cpp
 )

@@ -161,11 +161,15 @@ void ModbusProfile::store(RegisterImage& image, Table table, std::uint16_t addre
     if (wire_order && swaps()) {
         swap_pairs(table, address, values, &skip);
     }
-    if (written) {
-        for (std::size_t i = 0; i < values.size(); ++i) {
-            const RegisterDef* def = map_->find(table, static_cast<std::uint16_t>(address + i));
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        // Registers outside the map (the gaps a generic device's merged read bridges,
+        // docs/registers.md) are no value of the device: not kept.
+        const RegisterDef* def = map_->find(table, static_cast<std::uint16_t>(address + i));
+        if (def == nullptr) {
+            skip[i] = true;
+        } else if (written) {
             // A write-only register is a command, not a value a read would return.
-            if (def == nullptr || !can_read(def->access)) {
+            if (!can_read(def->access)) {
                 skip[i] = true;
             } else if (def->auto_reset) {
                 // Seed 001 §3.4 "Auto Reset": the controller sets it back to 0 once it

@@ -28,11 +28,34 @@ namespace {
     return std::size_t{s.address} + s.count;
 }
 
-/// The span covering @p units (ascending, adjacent).
+/// The span covering @p units (ascending).
 [[nodiscard]] RegisterSpan covering(const std::vector<RegisterSpan>& units) {
     const RegisterSpan& first = units.front();
     const std::size_t end = end_of(units.back());
     return RegisterSpan{first.table, first.address, static_cast<std::uint16_t>(end - first.address)};
+}
+
+/// @p units (ascending) cut where one does not start at the end of the previous.
+[[nodiscard]] std::vector<std::vector<RegisterSpan>> runs_of(const std::vector<RegisterSpan>& units) {
+    std::vector<std::vector<RegisterSpan>> runs;
+    for (const RegisterSpan& u : units) {
+        if (runs.empty() || end_of(runs.back().back()) != u.address) {
+            runs.emplace_back();
+        }
+        runs.back().push_back(u);
+    }
+    return runs;
+}
+
+/// A read of @p units (ascending): covering them, filling their runs.
+[[nodiscard]] PollItem item_of(std::vector<RegisterSpan> units) {
+    PollItem item;
+    item.payload = read_payload(covering(units));
+    for (const std::vector<RegisterSpan>& run : runs_of(units)) {
+        item.fills.push_back(covering(run));
+    }
+    item.units = std::move(units);
+    return item;
 }
 
 }  // namespace
@@ -66,20 +89,17 @@ std::vector<PollItem> merge_units(std::vector<PollUnit> units) {
         if (run.empty()) {
             return;
         }
-        PollItem item;
-        const RegisterSpan span = covering(run);
-        item.payload = read_payload(span);
+        PollItem item = item_of(std::move(run));
+        run.clear();
         item.poll_class = like.poll_class;
         item.period = like.period;
         item.motion = like.motion;
-        item.fills = {span};
-        item.units = std::move(run);
-        run.clear();
         items.push_back(std::move(item));
     };
 
     std::vector<RegisterSpan> run;
     const PollUnit* run_like = nullptr;
+    const PollUnit* previous = nullptr;
     for (const PollUnit& u : units) {
         if (u.span.count == 0) {
             continue;
@@ -87,13 +107,16 @@ std::vector<PollItem> merge_units(std::vector<PollUnit> units) {
         const bool same_group = run_like != nullptr && run_like->poll_class == u.poll_class &&
                                 run_like->period == u.period && run_like->motion == u.motion &&
                                 run_like->span.table == u.span.table;
-        const bool touches = same_group && !run.empty() && end_of(run.back()) == u.span.address;
-        const bool fits = touches && end_of(u.span) - run.front().address <= block_limit(u.span.table);
         // A unit polled twice at the same period (listed twice) is polled once.
         const bool duplicate = same_group && !run.empty() && run.back() == u.span;
         if (duplicate) {
             continue;
         }
+        const std::size_t gap = same_group && !run.empty() && u.span.address >= end_of(run.back())
+                                    ? u.span.address - end_of(run.back())
+                                    : std::size_t{0xFFFFFFFF};
+        const bool reaches = gap == 0 || (previous != nullptr && gap <= std::min(previous->max_gap, u.max_gap));
+        const bool fits = reaches && end_of(u.span) - run.front().address <= block_limit(u.span.table);
         if (!fits) {
             if (run_like != nullptr) {
                 flush(*run_like, run);
@@ -101,6 +124,7 @@ std::vector<PollItem> merge_units(std::vector<PollUnit> units) {
             run_like = &u;
         }
         run.push_back(u.span);
+        previous = &u;
     }
     if (run_like != nullptr) {
         flush(*run_like, run);
@@ -120,15 +144,11 @@ const PollItem* PollPlan::find(std::uint32_t id) const noexcept {
 }
 
 PollItem PollPlan::make_item(const PollItem& like, std::vector<RegisterSpan> units) {
-    PollItem item;
+    PollItem item = item_of(std::move(units));
     item.id = next_id_++;
-    const RegisterSpan span = covering(units);
-    item.payload = read_payload(span);
     item.poll_class = like.poll_class;
     item.period = like.period;
     item.motion = like.motion;
-    item.fills = {span};
-    item.units = std::move(units);
     return item;
 }
 
@@ -144,9 +164,18 @@ std::vector<PollItem> PollPlan::on_block_rejected(std::uint32_t id) {
         rejected_.insert(rejected_.end(), old.fills.begin(), old.fills.end());
         return {};
     }
+    std::vector<PollItem> split;
+    if (std::vector<std::vector<RegisterSpan>> runs = runs_of(old.units); runs.size() > 1) {
+        // The read bridged gaps that no unit names: one of them may be the culprit, so
+        // no read bridges them again.
+        for (std::vector<RegisterSpan>& run : runs) {
+            split.push_back(make_item(old, std::move(run)));
+        }
+        items_.insert(at, split.begin(), split.end());
+        return split;
+    }
     // Halves at a unit boundary: a single bad register is found in log2(n) rejections.
     const auto middle = old.units.begin() + static_cast<std::ptrdiff_t>(old.units.size() / 2);
-    std::vector<PollItem> split;
     split.push_back(make_item(old, std::vector<RegisterSpan>(old.units.begin(), middle)));
     split.push_back(make_item(old, std::vector<RegisterSpan>(middle, old.units.end())));
     items_.insert(at, split.begin(), split.end());

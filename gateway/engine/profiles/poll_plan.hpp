@@ -2,9 +2,10 @@
 /// @file poll_plan.hpp
 /// What a device agent polls, how often, and what each poll fills in the image.
 /// Spec §3 rule 8: adjacent registers polled at the same period are merged into one
-/// block read within the device's known map, never across a hole; a merged block
-/// the device answers with exception 0x02 is split, and the split is remembered (the
-/// plan keeps the split items from then on).
+/// block read within the device's known map, never across a hole (except the gaps of
+/// at most `max_gap` registers between a generic device's points, issue 25); a merged
+/// block the device answers with exception 0x02 is split, and the split is remembered
+/// (the plan keeps the split items from then on; a gap is never bridged again).
 
 #include <cstddef>
 #include <cstdint>
@@ -43,11 +44,13 @@ struct PollItem {
     /// Rule 5: while the device is in motion this item is polled at the `motion`
     /// period instead (it carries what in_motion() looks at).
     bool motion = false;
-    /// Image registers a good reply refreshes.
+    /// Image registers a good reply refreshes: the runs of adjacent units (a gap the
+    /// read bridges is not a register of the device's map and is not stored).
     std::vector<RegisterSpan> fills;
-    /// Modbus items: the map entries (single registers, 32-bit pairs, or bits) the
-    /// block was merged from, ascending and adjacent. A block of two or more units
-    /// can be split; ASCII items have none.
+    /// Modbus items: the map entries (single registers, 32-bit pairs, points, or bits)
+    /// the block was merged from, ascending; adjacent unless the block bridges gaps
+    /// (PollUnit::max_gap). A block of two or more units can be split; ASCII items
+    /// have none.
     std::vector<RegisterSpan> units;
 };
 
@@ -61,6 +64,10 @@ struct PollUnit {
     PollClass poll_class = PollClass::fast;
     Duration period{};
     bool motion = false;
+    /// Registers (bits) between this unit and a neighbour that a merged read may
+    /// bridge, when both allow it (the smaller wins): 0 (only touching units merge)
+    /// but for a generic device's points (`max_gap`).
+    std::uint16_t max_gap = 0;
 };
 
 /// The FC01/02/03/04 read of @p span.
@@ -68,9 +75,10 @@ struct PollUnit {
 
 /// Rule 8's merge: units of one table with the same class, period and motion flag
 /// whose spans touch (the next starts where the previous ends) become one block, up
-/// to 125 registers / 2000 bits. Units that do not touch are never bridged: the gap
-/// may be a hole the device rejects. Items come out ordered by class, then table,
-/// then address; ids are not assigned yet.
+/// to 125 registers / 2000 bits. Units that do not touch are bridged only across a
+/// gap both allow (PollUnit::max_gap): any other gap may be a hole the device
+/// rejects. Items come out ordered by class, then table, then address; ids are not
+/// assigned yet.
 [[nodiscard]] std::vector<PollItem> merge_units(std::vector<PollUnit> units);
 
 class PollPlan {
@@ -85,9 +93,11 @@ public:
     [[nodiscard]] const PollItem* find(std::uint32_t id) const noexcept;
 
     /// The device answered item @p id with exception 0x02 (illegal data address).
-    /// A block of several units is replaced by two halves (split at a unit boundary,
-    /// so a 32-bit pair is never cut), which are returned with fresh ids; a half that
-    /// is rejected again is split again, down to single units. A single unit that is
+    /// A block that bridges gaps is replaced by its runs of adjacent units (the gap
+    /// may be the culprit: it is never read again); a block of adjacent units by two
+    /// halves (split at a unit boundary, so a 32-bit pair or a point is never cut).
+    /// The new items are returned with fresh ids; one that is rejected again is split
+    /// again, down to single units. A single unit that is
     /// rejected is dropped from the plan and listed in rejected(). Returns the items
     /// that replace @p id (empty when it was dropped or is unknown).
     std::vector<PollItem> on_block_rejected(std::uint32_t id);

@@ -55,9 +55,9 @@ std::optional<RequestSpan> request_span(const protocol::Request& request) {
 
 RegisterMap::RegisterMap(std::vector<RegisterDef> defs) {
     for (RegisterDef& d : defs) {
-        if (d.width < 1 || d.width > 2 || d.count == 0 || d.end() > 0x10000) {
+        if (d.width < 1 || d.width > max_unit_width || d.count == 0 || d.end() > 0x10000) {
             throw core::InvalidArgument("register map entry '" + d.name + "' at " + std::to_string(d.address) +
-                                        ": width must be 1 or 2, count at least 1, and it must end by 0xFFFF");
+                                        ": width must be 1-125, count at least 1, and it must end by 0xFFFF");
         }
         tables_[static_cast<std::size_t>(d.table)].push_back(std::move(d));
     }
@@ -97,12 +97,13 @@ std::optional<protocol::ExceptionCode> RegisterMap::check(Table table, std::uint
         if (d == nullptr || (write ? !can_write(d->access) : !can_read(d->access))) {
             return protocol::ExceptionCode::illegal_data_address;
         }
-        if (write && d->width == 2) {
-            // The manual's pairs must be written whole (spec §5, EXCD203MB).
-            if ((a - d->address) % 2 != 0 && a == address) {
+        if (write && d->width > 1) {
+            // The manual's pairs (spec §5, EXCD203MB) and a generic device's points of
+            // several registers must be written whole.
+            if ((a - d->address) % d->width != 0 && a == address) {
                 return protocol::ExceptionCode::illegal_data_address;
             }
-            if (end < d->end() && (end - d->address) % 2 != 0) {
+            if (end < d->end() && (end - d->address) % d->width != 0) {
                 return protocol::ExceptionCode::illegal_data_address;
             }
         }
@@ -132,7 +133,7 @@ std::vector<PollUnit> RegisterMap::poll_units(const RegisterSpan& span, PollClas
                                               bool motion) const {
     std::vector<PollUnit> out;
     for (const UnitRef& u : units(span.table, span.address, span.count)) {
-        out.push_back(PollUnit{RegisterSpan{span.table, u.address, u.def->width}, poll_class, period, motion});
+        out.push_back(PollUnit{RegisterSpan{span.table, u.address, u.def->width}, poll_class, period, motion, 0});
     }
     return out;
 }
@@ -144,6 +145,8 @@ std::vector<WrittenUnit> written_units(const RegisterMap& map, const RequestSpan
         if (u.address < span.address || i + u.def->width > span.values.size()) {
             continue;  // half a pair at an edge: not a whole written value
         }
+        // Wider units (points of a generic device): the first register; the profile
+        // checks the whole value (GenericProfile).
         const std::int64_t value = u.def->width == 2 ? pair_value(span.values[i], span.values[i + 1], u.def->is_signed)
                                                      : std::int64_t{span.values[i]};
         out.push_back(WrittenUnit{u.def, u.address, value});

@@ -1,7 +1,8 @@
 #pragma once
 /// @file register_map.hpp
 /// A device's known register map: which addresses exist in which table, how wide
-/// each value is (one register or a 32-bit pair), who may read or write it, its
+/// each value is (one register, a 32-bit pair, or a generic device's point of up to
+/// 125 registers), who may read or write it, its
 /// value range, and what writing it means (motion, stop, protected). Profiles build
 /// one from their manual; validation (spec §4: 0x02 outside the map or across a
 /// hole, half a pair written; 0x03 out of range) and poll planning read it.
@@ -26,13 +27,17 @@ enum class Access : std::uint8_t { read = 1, write = 2, read_write = 3 };
 [[nodiscard]] constexpr bool can_read(Access a) noexcept { return (static_cast<unsigned>(a) & 1U) != 0; }
 [[nodiscard]] constexpr bool can_write(Access a) noexcept { return (static_cast<unsigned>(a) & 2U) != 0; }
 
+/// The widest unit of a map: a point of a generic device read in one request.
+inline constexpr std::uint8_t max_unit_width = 125;
+
 /// One entry: @p count consecutive units of @p width registers each, all alike
 /// (EXCD's n01..n99 is one entry of 99 pairs). Northbound, a pair is always high
-/// word first (at the lower address).
+/// word first (at the lower address). A unit wider than one register is written
+/// whole or not at all.
 struct RegisterDef {
     Table table = Table::holding;
     std::uint16_t address = 0;
-    std::uint8_t width = 1;   ///< 1, or 2 for a 32-bit pair
+    std::uint8_t width = 1;   ///< 1; 2 for a 32-bit pair; up to 125 for a generic device's point
     std::uint16_t count = 1;  ///< units in this entry
     Access access = Access::read_write;
     bool is_signed = false;   ///< pairs: two's complement 32-bit
@@ -80,7 +85,7 @@ struct RequestSpan {
 class RegisterMap {
 public:
     RegisterMap() = default;
-    /// Throws core::InvalidArgument when entries overlap, have width outside 1-2 or
+    /// Throws core::InvalidArgument when entries overlap, have width outside 1-125 or
     /// count 0, or run past 0xFFFF: a map is written once, in a profile's source.
     explicit RegisterMap(std::vector<RegisterDef> defs);
 
@@ -89,7 +94,7 @@ public:
 
     /// 0x02 (illegal data address) when any address of the span is in a hole, or
     /// is not readable (reads) / writable (writes), or when a write starts or ends
-    /// inside a pair; nullopt when the span is addressable. Reading half a pair is
+    /// inside a pair (or a wider unit); nullopt when the span is addressable. Reading half a pair is
     /// allowed: it is harmless and some clients read one word at a time.
     [[nodiscard]] std::optional<protocol::ExceptionCode> check(Table table, std::uint16_t address,
                                                                std::uint16_t count, bool write) const;
@@ -127,7 +132,8 @@ using ValueCheck = std::function<std::optional<protocol::ExceptionCode>(const Re
                                                                       bool allow_protected,
                                                                       const ValueCheck& extra);
 
-/// Every written unit with its value (pairs: the 32-bit value, high word first).
+/// Every written unit with its value (pairs: the 32-bit value, high word first;
+/// wider units: their first register).
 struct WrittenUnit {
     const RegisterDef* def = nullptr;
     std::uint16_t address = 0;

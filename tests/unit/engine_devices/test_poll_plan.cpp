@@ -20,7 +20,7 @@ using std::chrono::milliseconds;
 
 PollUnit unit(std::uint16_t address, std::uint16_t count, PollClass c = PollClass::fast,
               fe::Duration period = milliseconds{50}, Table table = Table::holding) {
-    return PollUnit{RegisterSpan{table, address, count}, c, period, false};
+    return PollUnit{RegisterSpan{table, address, count}, c, period, false, 0};
 }
 
 fp::ReadRegistersRequest read_of(const fe::PollItem& item) {
@@ -136,4 +136,59 @@ TEST_CASE("poll plan: split on 0x02 down to single units, remembered; a lone uni
     CHECK(read_of(plan.items()[1]) == fp::ReadRegistersRequest{fp::fc::read_holding_registers, 2, 1});
 
     CHECK(plan.on_block_rejected(9999).empty());  // unknown id
+}
+
+namespace {
+
+PollUnit bridging(std::uint16_t address, std::uint16_t count, std::uint16_t max_gap) {
+    return PollUnit{RegisterSpan{Table::input, address, count}, PollClass::custom, milliseconds{1000}, false, max_gap};
+}
+
+}  // namespace
+
+TEST_CASE("poll plan: units that allow a gap merge across it, up to the smaller max_gap and 125 registers") {
+    // Gaps of 2 and 8: bridged at max_gap 8; the read fills only the units' runs.
+    auto items = fe::merge_units({bridging(0, 2, 8), bridging(4, 1, 8), bridging(13, 2, 8), bridging(24, 1, 8)});
+    REQUIRE(items.size() == 2);
+    CHECK(read_of(items[0]) == fp::ReadRegistersRequest{fp::fc::read_input_registers, 0, 15});
+    CHECK(items[0].fills == std::vector<RegisterSpan>{{Table::input, 0, 2}, {Table::input, 4, 1}, {Table::input, 13, 2}});
+    CHECK(items[0].units.size() == 3);
+    CHECK(read_of(items[1]).address == 24);  // a gap of 9
+    // The smaller max_gap of the two neighbours wins: 0 is today's rule.
+    items = fe::merge_units({bridging(0, 2, 8), bridging(4, 1, 0)});
+    CHECK(items.size() == 2);
+    items = fe::merge_units({bridging(0, 2, 8), bridging(4, 1, 2), bridging(7, 1, 8)});
+    REQUIRE(items.size() == 1);
+    CHECK(read_of(items[0]).count == 8);
+    // Never past one read.
+    items = fe::merge_units({bridging(0, 100, 8), bridging(105, 20, 8), bridging(125, 1, 8)});
+    REQUIRE(items.size() == 2);
+    CHECK(read_of(items[0]).count == 125);
+    CHECK(read_of(items[1]).address == 125);
+}
+
+TEST_CASE("poll plan: a read across gaps refused with 0x02 is split at its gaps, never bridged again") {
+    PollPlan plan{fe::merge_units({bridging(0, 2, 8), bridging(2, 1, 8), bridging(6, 2, 8), bridging(10, 1, 8)})};
+    REQUIRE(plan.items().size() == 1);
+    const std::uint32_t id = plan.items()[0].id;
+    CHECK(read_of(plan.items()[0]).count == 11);
+    const auto split = plan.on_block_rejected(id);
+    REQUIRE(split.size() == 3);  // the runs 0-2, 6-7, 10
+    CHECK(read_of(split[0]) == fp::ReadRegistersRequest{fp::fc::read_input_registers, 0, 3});
+    CHECK(read_of(split[1]) == fp::ReadRegistersRequest{fp::fc::read_input_registers, 6, 2});
+    CHECK(read_of(split[2]) == fp::ReadRegistersRequest{fp::fc::read_input_registers, 10, 1});
+    CHECK(plan.items().size() == 3);
+    CHECK(plan.find(id) == nullptr);
+    // A run refused again: halves at a unit boundary, as any block.
+    const auto halves = plan.on_block_rejected(split[0].id);
+    REQUIRE(halves.size() == 2);
+    CHECK(read_of(halves[0]) == fp::ReadRegistersRequest{fp::fc::read_input_registers, 0, 2});
+    CHECK(read_of(halves[1]) == fp::ReadRegistersRequest{fp::fc::read_input_registers, 2, 1});
+    // A single unit refused alone: remembered, not polled again.
+    CHECK(plan.on_block_rejected(split[2].id).empty());
+    CHECK(std::vector<RegisterSpan>(plan.rejected().begin(), plan.rejected().end()) ==
+          std::vector<RegisterSpan>{{Table::input, 10, 1}});
+    for (const auto& item : plan.items()) {
+        CHECK(item.fills.size() == 1);  // no item bridges a gap any more
+    }
 }
