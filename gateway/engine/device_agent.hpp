@@ -56,6 +56,9 @@ namespace fieldbridge::engine {
 
 struct DeviceAgentConfig {
     std::string name;             ///< the device's config name, for logs and MQTT
+    /// The `type:` as configured (a built-in type or a device definition's name); ""
+    /// in tests: the profile's type then.
+    std::string type_name;
     std::string line_name;
     DeviceIndex index = 0;        ///< its index on the line's scheduler
     core::BusAddress address{1};

@@ -93,6 +93,7 @@ DeviceAgentConfig device_agent_config(const config::LineConfig& line, const conf
                                       DeviceIndex index) {
     DeviceAgentConfig agent;
     agent.name = device.name;
+    agent.type_name = device.type_name;
     agent.line_name = line.name;
     agent.index = index;
     agent.address = device.address;

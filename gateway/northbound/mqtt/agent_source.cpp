@@ -4,6 +4,7 @@
 
 #include <asio/post.hpp>
 
+#include "engine/profiles/modbus_profile.hpp"
 #include "protocol/gateway_exceptions.hpp"
 
 namespace fieldbridge::northbound::mqtt {
@@ -38,10 +39,14 @@ AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool 
     : io_(io),
       agent_(&agent),
       name_(agent.config().name),
-      type_(agent.profile().type()),
+      type_(agent.config().type_name.empty() ? std::string{engine::to_string(agent.profile().type())}
+                                              : agent.config().type_name),
       operations_(agent.profile().operations()),
       commands_enabled_(commands_enabled),
       listener_(std::make_shared<SourceListener>()) {
+    if (const auto* modbus = dynamic_cast<const engine::ModbusProfile*>(&agent.profile())) {
+        points_ = modbus->options().points;
+    }
     const std::weak_ptr<SourceListener> weak = listener_;
     subscription_ = agent.image().subscribe([weak](const engine::ImageChange&) {
         if (auto l = weak.lock(); l && l->changed) l->changed();
@@ -63,7 +68,7 @@ void AgentSource::detach() noexcept {
     *listener_ = SourceListener{};
 }
 
-std::string_view AgentSource::type() const { return engine::to_string(type_); }
+std::string_view AgentSource::type() const { return type_; }
 
 SourceState AgentSource::state() const {
     if (agent_ == nullptr) {

@@ -26,6 +26,9 @@ public:
     [[nodiscard]] std::string_view type() const override;
     /// The profile's, kept: valid after detach() (operations.hpp: static storage).
     [[nodiscard]] engine::OperationSet operations() const override { return operations_; }
+    [[nodiscard]] const core::PointModel* points() const override {
+        return points_.points.empty() ? nullptr : &points_;
+    }
     [[nodiscard]] bool commands_enabled() const override { return commands_enabled_; }
     [[nodiscard]] SourceState state() const override;
     [[nodiscard]] std::vector<engine::Alarm> alarms() const override;
@@ -40,8 +43,9 @@ private:
     asio::io_context& io_;
     engine::DeviceAgent* agent_;
     std::string name_;
-    engine::DeviceType type_;
+    std::string type_;
     engine::OperationSet operations_;
+    core::PointModel points_;  ///< kept: valid after detach()
     bool commands_enabled_;
     engine::RegisterImage::SubscriptionId subscription_ = 0;
     // Shared with the image's listener and the notice callback, which the engine

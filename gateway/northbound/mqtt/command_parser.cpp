@@ -7,6 +7,8 @@
 #include <set>
 #include <utility>
 
+#include "northbound/mqtt/point_commands.hpp"
+
 namespace fieldbridge::northbound::mqtt {
 
 namespace {
@@ -237,6 +239,28 @@ std::vector<Request> device_op(Fields& f, const engine::Operation& op, std::span
     return json::parse(payload, check, /*allow_exceptions=*/false);
 }
 
+/// `write` / `read` of a device with points: only `values` / `points` besides id and op.
+ParseResult point_command(const json& command, const json& id, const std::string& op,
+                          const core::PointModel& points) {
+    const std::string member = op == "write" ? "values" : "points";
+    for (const auto& [key, value] : command.items()) {
+        if (key != "id" && key != "op" && key != member) {
+            return CommandError{CommandErrorKind::invalid_field, "field '" + key + "' is not taken by this op", id, op};
+        }
+    }
+    const auto it = command.find(member);
+    const json* given = it == command.end() ? nullptr : &*it;
+    PointOp built = op == "write" ? point_write(points, given) : point_read(points, given);
+    if (!built.ok()) {
+        static constexpr std::array kinds{CommandErrorKind::missing_field, CommandErrorKind::invalid_field,
+                                          CommandErrorKind::out_of_range};
+        const auto kind = std::find_if(kinds.begin(), kinds.end(), [&](auto k) { return to_string(k) == built.kind; });
+        return CommandError{kind == kinds.end() ? CommandErrorKind::invalid_field : *kind, std::move(built.message),
+                            id, op};
+    }
+    return ParsedCommand{id, op, std::move(built.requests), std::move(built.read_points)};
+}
+
 }  // namespace
 
 std::string_view to_string(CommandErrorKind kind) noexcept {
@@ -252,15 +276,17 @@ std::string_view to_string(CommandErrorKind kind) noexcept {
     return "unknown";
 }
 
-std::vector<std::string_view> command_ops(const engine::OperationSet& operations) {
+std::vector<std::string_view> command_ops(const engine::OperationSet& operations, const core::PointModel* points) {
     std::vector<std::string_view> names;
     for (const engine::Operation& op : operations.operations) names.push_back(op.name);
+    if (points != nullptr && takes_point_write(*points)) names.push_back("write");
+    if (points != nullptr && takes_point_read(*points)) names.push_back("read");
     for (const auto& [name, op] : raw_ops) names.push_back(name);
     return names;
 }
 
 ParseResult parse_command(std::string_view payload, const engine::OperationSet& operations,
-                          std::span<const RawRegister> registers) {
+                          std::span<const RawRegister> registers, const core::PointModel* points) {
     std::string duplicate;
     const json command = parse_strict(payload, duplicate);
     if (command.is_discarded() || !command.is_object()) {
@@ -286,9 +312,13 @@ ParseResult parse_command(std::string_view payload, const engine::OperationSet& 
     // The device's own operations first: they may refine a raw op of the same name.
     const engine::Operation* own = operations.find(op);
     const auto raw = std::find_if(raw_ops.begin(), raw_ops.end(), [&](const auto& e) { return e.first == op; });
+    if (own == nullptr && points != nullptr &&
+        ((op == "write" && takes_point_write(*points)) || (op == "read" && takes_point_read(*points)))) {
+        return point_command(command, id, op, *points);
+    }
     if (own == nullptr && raw == raw_ops.end()) {
         std::string known;
-        for (const std::string_view name : command_ops(operations)) {
+        for (const std::string_view name : command_ops(operations, points)) {
             known += known.empty() ? "" : ", ";
             known += name;
         }

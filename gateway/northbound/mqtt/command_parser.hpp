@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/point.hpp"
 #include "northbound/mqtt/device_source.hpp"
 #include "protocol/modbus_pdu.hpp"
 
@@ -29,6 +30,8 @@ struct ParsedCommand {
     nlohmann::json id;
     std::string op;
     std::vector<protocol::Request> requests;
+    /// `read` of a device with points: the points the result carries (docs/mqtt.md).
+    std::vector<std::string> read_points;
 };
 
 /// Why a command was refused before anything was sent.
@@ -56,12 +59,15 @@ using ParseResult = std::variant<ParsedCommand, CommandError>;
 
 /// @p operations: the device's (DeviceSource::operations()); @p registers: its
 /// register image as the source shows it (SourceState::raw: every register that has
-/// a value); ops that need none ignore it.
+/// a value); ops that need none ignore it. @p points: the device's points (nullptr:
+/// none), which add the ops `write` and `read` (point_commands.hpp).
 [[nodiscard]] ParseResult parse_command(std::string_view payload, const engine::OperationSet& operations,
-                                        std::span<const RawRegister> registers);
+                                        std::span<const RawRegister> registers,
+                                        const core::PointModel* points = nullptr);
 
-/// The ops a device of @p operations takes: its own, then the raw register ops (for
-/// error messages and docs).
-[[nodiscard]] std::vector<std::string_view> command_ops(const engine::OperationSet& operations);
+/// The ops a device of @p operations takes: its own, then the point ops, then the raw
+/// register ops (for error messages and docs).
+[[nodiscard]] std::vector<std::string_view> command_ops(const engine::OperationSet& operations,
+                                                        const core::PointModel* points = nullptr);
 
 }  // namespace fieldbridge::northbound::mqtt

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/point.hpp"
 #include "engine/device_agent.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "engine/register_image.hpp"
@@ -53,6 +54,9 @@ public:
     /// The MQTT operations of its type (its profile's; none but the raw register ops
     /// for a generic Modbus device): docs/mqtt.md, "Commands".
     [[nodiscard]] virtual engine::OperationSet operations() const = 0;
+    /// The device's named points (generic Modbus devices with points or a definition
+    /// file); nullptr when it has none. They add the ops `write` and `read`.
+    [[nodiscard]] virtual const core::PointModel* points() const { return nullptr; }
     /// False: `mqtt_commands: false` in the device's config; every command is refused.
     [[nodiscard]] virtual bool commands_enabled() const = 0;
 

@@ -59,11 +59,23 @@ public:
         bool scheduled = false;
     };
 
+    /// The bridge's throttle settings, with the deadbands of the source's points (a
+    /// point's own `deadband` wins over `mqtt.deadband` of the same field name).
+    [[nodiscard]] ThrottleSettings throttle_for(const DeviceSource& source) const {
+        ThrottleSettings settings = s_.throttle;
+        if (const core::PointModel* points = source.points()) {
+            for (const core::PointDef& point : points->points) {
+                if (point.deadband) settings.deadband[point.name] = *point.deadband;
+            }
+        }
+        return settings;
+    }
+
     void set_sources(std::vector<std::shared_ptr<DeviceSource>> sources) {
         for (auto& [name, device] : devices_) device->source->set_listener({});
         devices_.clear();
         for (auto& source : sources) {
-            auto device = std::make_unique<Device>(Device{source, StateThrottle(s_.throttle), AlarmTracker(s_.alarms),
+            auto device = std::make_unique<Device>(Device{source, StateThrottle(throttle_for(*source)), AlarmTracker(s_.alarms),
                                                           topic(source->name(), "state"),
                                                           topic(source->name(), "alarm"), false});
             const std::weak_ptr<Impl> weak = weak_from_this();
@@ -483,7 +495,7 @@ private:
             if (it == devices_.end()) return parse_command(message.payload, engine::OperationSet{}, {});
             // Some ops depend on the device's registers (WTEC grip / release: the init direction).
             const DeviceSource& source = *it->second->source;
-            return parse_command(message.payload, source.operations(), source.state().raw);
+            return parse_command(message.payload, source.operations(), source.state().raw, source.points());
         }();
         json id;
         std::string op;
@@ -523,7 +535,10 @@ private:
         }
         const auto& command = std::get<ParsedCommand>(parsed);
         run_command(io_, it->second->source, command.requests,
-                    [weak = weak_from_this(), name, id, op](CommandOutcome outcome) {
+                    [weak = weak_from_this(), source = it->second->source, read = command.read_points, name, id,
+                     op](CommandOutcome outcome) {
+                        // `read`: the values as the image holds them now, the replies applied.
+                        if (outcome.ok && !read.empty()) outcome.values = point_values(source->state(), read);
                         if (auto self = weak.lock()) self->answer(name, id, op, outcome);
                     });
     }

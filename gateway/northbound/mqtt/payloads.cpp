@@ -114,6 +114,7 @@ json command_result_payload(std::string_view device, const json& id, std::string
     out["device"] = device;
     out["op"] = op;
     out["ok"] = outcome.ok;
+    if (!outcome.values.is_null()) out["values"] = outcome.values;
     if (!outcome.ok) {
         out["error"] = outcome.error;
         out["message"] = outcome.message;
@@ -122,6 +123,16 @@ json command_result_payload(std::string_view device, const json& id, std::string
         }
     }
     put_time(out, "time", clock.wall);
+    return out;
+}
+
+json point_values(const SourceState& state, const std::vector<std::string>& names) {
+    json out = json::object();
+    for (const std::string& name : names) {
+        const engine::Field* field = state.decoded.find(name);
+        out[name] = field != nullptr ? to_json(field->value) : json();
+        if (const engine::Field* code = state.decoded.find(name + "_code")) out[name + "_code"] = to_json(code->value);
+    }
     return out;
 }
 

@@ -72,9 +72,14 @@ struct CommandOutcome {
     std::string error;    ///< kind: "unknown_op", "rejected", "device_exception", "no_answer", ...
     std::string message;  ///< what failed and what to do
     std::optional<protocol::ExceptionCode> exception;  ///< the Modbus exception behind it, if any
+    nlohmann::json values;  ///< `read` of points: {name: value, <name>_code: code}; null otherwise
 };
 
-/// {"id", "device", "op", "ok", "error"?, "message"?, "exception"?, "time", "time_ms"}.
+/// The decoded values of the points @p names in @p state, as the state's `fields`
+/// show them (an enum point with its `<name>_code`); a point without a value: null.
+[[nodiscard]] nlohmann::json point_values(const SourceState& state, const std::vector<std::string>& names);
+
+/// {"id", "device", "op", "ok", "values"?, "error"?, "message"?, "exception"?, "time", "time_ms"}.
 [[nodiscard]] nlohmann::json command_result_payload(std::string_view device, const nlohmann::json& id,
                                                     std::string_view op, const CommandOutcome& outcome,
                                                     const ClockPair& clock);
