@@ -330,7 +330,7 @@ ParseResult parse_command(std::string_view payload, const engine::OperationSet& 
         Fields fields(command);
         std::vector<Request> requests = own != nullptr ? device_op(fields, *own, registers) : raw->second(fields);
         fields.finish();
-        return ParsedCommand{id, op, std::move(requests)};
+        return ParsedCommand{id, op, std::move(requests), {}};
     } catch (const Refusal& refusal) {
         return CommandError{refusal.kind, refusal.message, id, op};
     }

@@ -486,7 +486,7 @@ private:
                    CommandOutcome{false, "too_large",
                                   "the command is larger than " + std::to_string(s_.max_command_bytes) +
                                       " bytes (mqtt.max_command_bytes); not read",
-                                  std::nullopt});
+                                  std::nullopt, {}});
             return;
         }
         const ParseResult parsed = [&]() -> ParseResult {
@@ -507,7 +507,7 @@ private:
             op = bounded(std::get<ParsedCommand>(parsed).op);
         }
         const auto refuse = [&](std::string kind, std::string text) {
-            answer(name, id, op, CommandOutcome{false, std::move(kind), std::move(text), std::nullopt});
+            answer(name, id, op, CommandOutcome{false, std::move(kind), std::move(text), std::nullopt, {}});
         };
         const auto it = devices_.find(name);
         if (it == devices_.end()) {

@@ -98,10 +98,28 @@ TEST_CASE("payloads: alarm event, active set and command result") {
     CHECK(ok["id"] == "c-1");
     CHECK(ok["ok"] == true);
     CHECK_FALSE(ok.contains("error"));
-    fm::CommandOutcome failed{false, "rejected", "out of range", fieldbridge::protocol::ExceptionCode::illegal_data_value};
+    fm::CommandOutcome failed{false, "rejected", "out of range", fieldbridge::protocol::ExceptionCode::illegal_data_value,
+                               {}};
     const json bad = fm::command_result_payload("g1", json(7), "move", failed, clock);
     CHECK(bad["id"] == 7);
     CHECK(bad["ok"] == false);
     CHECK(bad["error"] == "rejected");
     CHECK(bad["exception"] == 3);
+}
+
+TEST_CASE("payloads: a read's result carries the points' values, an enum with its code") {
+    const fm::ClockPair clock = fixed_clock();
+    fm::SourceState state;
+    state.decoded.fields = {fieldbridge::engine::Field{"temperature", 20.25, "°C"},
+                            fieldbridge::engine::Field{"mode", std::string{"heat"}, ""},
+                            fieldbridge::engine::Field{"mode_code", std::int64_t{1}, ""}};
+    const json values = fm::point_values(state, {"mode", "temperature", "setpoint"});
+    CHECK(values == json::parse(R"({"mode":"heat","mode_code":1,"temperature":20.25,"setpoint":null})"));
+    fm::CommandOutcome read;
+    read.values = values;
+    const json result = fm::command_result_payload("t1", json(8), "read", read, clock);
+    CHECK(result["ok"] == true);
+    CHECK(result["values"]["mode"] == "heat");
+    // Other results have no `values`.
+    CHECK_FALSE(fm::command_result_payload("t1", json(9), "stop", fm::CommandOutcome{}, clock).contains("values"));
 }

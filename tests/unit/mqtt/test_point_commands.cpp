@@ -79,7 +79,7 @@ TEST_CASE("write is all or nothing: the first refusal names the point and nothin
     const auto model = thermostat();
     const auto unknown = refused(R"({"id":1,"op":"write","values":{"setpoint":20,"fan":1}})", model);
     CHECK(unknown.kind == fm::CommandErrorKind::invalid_field);
-    CHECK(unknown.message.find("'fan'") != std::string::npos);
+    CHECK(unknown.message.find("\"fan\"") != std::string::npos);
     const auto read_only = refused(R"({"id":1,"op":"write","values":{"temperature":20}})", model);
     CHECK(read_only.kind == fm::CommandErrorKind::invalid_field);
     CHECK(read_only.message.find("read-only") != std::string::npos);
@@ -89,7 +89,7 @@ TEST_CASE("write is all or nothing: the first refusal names the point and nothin
           fm::CommandErrorKind::invalid_field);
     const auto too_high = refused(R"({"id":1,"op":"write","values":{"mode":"heat","setpoint":35.5}})", model);
     CHECK(too_high.kind == fm::CommandErrorKind::out_of_range);
-    CHECK(too_high.message.find("'setpoint'") != std::string::npos);
+    CHECK(too_high.message.find("\"setpoint\"") != std::string::npos);
     CHECK(refused(R"({"id":1,"op":"write","values":{"mode":"auto"}})", model).kind ==
           fm::CommandErrorKind::out_of_range);
     CHECK(refused(R"({"id":1,"op":"write"})", model).kind == fm::CommandErrorKind::missing_field);
