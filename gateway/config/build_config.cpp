@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "config/build_points.hpp"
 #include "config/validate.hpp"
 
 namespace fieldbridge::config {
@@ -74,7 +75,7 @@ void set(T& target, const Field<T>& field) {
     DeviceConfig device;
     device.name = *raw.name;
     device.type = *raw.type;
-    device.type_name = std::string{core::to_string(device.type)};
+    device.type_name = *raw.type_name;
     device.address = core::BusAddress{static_cast<std::uint8_t>(*raw.address)};
     device.unit_id = core::UnitId{static_cast<std::uint8_t>(*raw.unit_id)};
     set(device.max_age, raw.max_age);
@@ -92,15 +93,23 @@ void set(T& target, const Field<T>& field) {
     if (raw.stroke.has_value()) {
         device.stroke = static_cast<std::uint32_t>(*raw.stroke);
     }
-    for (const auto& raw_block : raw.blocks.items) {
-        RegisterBlock block;
-        block.table = *raw_block.table;
-        block.address = static_cast<std::uint16_t>(*raw_block.address);
-        block.count = static_cast<std::uint16_t>(*raw_block.count);
-        set(block.period, raw_block.period);
-        set(block.writable, raw_block.writable);
-        device.blocks.push_back(block);
+    if (device.type != DeviceType::modbus) {
+        return device;
     }
+    const RawDefinition* definition = raw.definition.get();
+    const PointDefaults defaults = point_defaults(definition, &raw);
+    device.word_order = defaults.word_order;
+    device.period = defaults.period;
+    if (definition != nullptr) {
+        device.definition_file = definition->file;
+        for (const auto& raw_block : definition->blocks.items) {
+            device.blocks.push_back(build_block(raw_block, defaults.period));
+        }
+    }
+    for (const auto& raw_block : raw.blocks.items) {
+        device.blocks.push_back(build_block(raw_block, defaults.period));
+    }
+    device.points = build_point_model(definition, &raw, defaults);
     return device;
 }
 

@@ -204,6 +204,10 @@ struct DeviceConfig {
     /// Points and alarms (the definition's, then the inline ones) and `max_gap`;
     /// empty for the built-in types.
     core::PointModel points;
+    /// Generic devices: the poll period of points (and blocks) that set none.
+    milliseconds period = seconds{1};
+    /// Registers (bits) no point names that one merged read may bridge.
+    static constexpr Range<std::int64_t> max_gap_range{0, 124};
     bool operator==(const DeviceConfig&) const = default;
 };
 

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "config/build_config.hpp"
+#include "config/definition_files.hpp"
 #include "config/diagnostic_sink.hpp"
 #include "config/raw_parse.hpp"
 #include "config/validate.hpp"
@@ -47,7 +48,8 @@ namespace {
         sink.error(to_mark(*documents.second, Mark{1, 1}), "",
                    "a second YAML document starts here (---); expected a single document");
     }
-    const RawConfig raw = parse_raw(documents.first, sink);
+    RawConfig raw = parse_raw(documents.first, sink);
+    resolve_definitions(raw, base_dir, sink);
     validate(raw, base_dir, sink);
     if (!sink.empty()) {
         throw ConfigError(sink.take_sorted());

@@ -37,7 +37,12 @@ namespace {
 ConfigError::ConfigError(std::vector<Diagnostic> d) : core::Error(join_lines(d)), diagnostics_(std::move(d)) {}
 
 std::vector<Diagnostic> DiagnosticSink::take_sorted() {
-    std::stable_sort(diagnostics_.begin(), diagnostics_.end(), [](const Diagnostic& a, const Diagnostic& b) {
+    std::stable_sort(diagnostics_.begin(), diagnostics_.end(), [this](const Diagnostic& a, const Diagnostic& b) {
+        const bool a_other = a.file != file_;
+        const bool b_other = b.file != file_;
+        if (a_other || b_other) {
+            return !a_other && b_other;  // another file's keep their order, after this file's
+        }
         return a.line != b.line ? a.line < b.line : a.column < b.column;
     });
     return std::move(diagnostics_);

@@ -25,10 +25,14 @@ public:
     }
     void error(const RawNode& node, std::string message) { error(node.mark, node.path, std::move(message)); }
 
+    /// A problem found in another file (a device definition).
+    void add(Diagnostic diagnostic) { diagnostics_.push_back(std::move(diagnostic)); }
+
     [[nodiscard]] bool empty() const noexcept { return diagnostics_.empty(); }
     [[nodiscard]] std::size_t size() const noexcept { return diagnostics_.size(); }
     [[nodiscard]] const std::string& file() const noexcept { return file_; }
-    /// Sorted by position (stable, so problems at one position keep their order).
+    /// Sorted by position (stable, so problems at one position keep their order); the
+    /// sink's own file first, then the other files' problems in the order they came.
     [[nodiscard]] std::vector<Diagnostic> take_sorted();
 
 private:

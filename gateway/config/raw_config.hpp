@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -116,8 +117,72 @@ struct RawBlock : RawNode {
     Field<bool> writable;
 };
 
+/// `enum:` of a point: raw value -> label, each with its position.
+struct RawEnum : RawNode {
+    std::vector<std::pair<Field<std::int64_t>, Field<std::string>>> entries;
+};
+
+/// One point (inline under a device, or in a device definition file).
+struct RawPoint : RawNode {
+    Field<std::string> name;
+    Field<RegisterTable> table;
+    Field<std::int64_t> address;
+    Field<core::PointType> type;
+    Field<std::int64_t> bit;
+    Field<std::int64_t> count;
+    Field<WordOrder> word_order;
+    Field<core::ByteOrder> byte_order;
+    Field<double> scale;
+    Field<double> offset;
+    Field<std::string> unit;
+    RawEnum labels;
+    Field<bool> writable;
+    Field<double> min;
+    Field<double> max;
+    Field<std::chrono::milliseconds> period;
+    Field<double> deadband;
+};
+
+struct RawAlarm : RawNode {
+    Field<std::string> name;
+    Field<std::string> point;
+    Field<double> above;
+    Field<double> below;
+    Field<std::string> equals;  ///< a number, or an enum label of the point
+    Field<std::string> not_equals;
+    Field<std::int64_t> bit;
+    Field<double> hysteresis;
+    Field<core::AlarmSeverity> severity;
+    Field<std::string> text;
+};
+
+struct RawIdentify : RawNode {
+    Field<RegisterTable> table;
+    Field<std::int64_t> address;
+    Field<std::int64_t> count;
+    FieldList<std::int64_t> expect;
+};
+
+/// A device definition file (`<dir>/<name>.yaml`), as written. Its positions are
+/// in `file`, not in the configuration.
+struct RawDefinition : RawNode {
+    std::string file;  ///< absolute path
+    Field<std::string> name;
+    Field<std::string> description;
+    Field<WordOrder> word_order;
+    Field<std::chrono::milliseconds> period;
+    Field<std::int64_t> max_gap;
+    RawSeq<RawPoint> points;
+    RawSeq<RawAlarm> alarms;
+    RawSeq<RawBlock> blocks;
+    RawIdentify identify;
+};
+
 struct RawDevice : RawNode {
     Field<std::string> name;
+    /// `type:` as written; `type` holds it when it names a built-in type, and
+    /// DeviceType::modbus once a definition of that name was found (`definition`).
+    Field<std::string> type_name;
     Field<DeviceType> type;
     Field<std::int64_t> address;
     Field<std::int64_t> unit_id;
@@ -133,6 +198,13 @@ struct RawDevice : RawNode {
     Field<WordOrder> word_order;
     Field<std::int64_t> stroke;
     RawSeq<RawBlock> blocks;
+    Field<std::chrono::milliseconds> period;
+    Field<std::int64_t> max_gap;
+    RawSeq<RawPoint> points;
+    RawSeq<RawAlarm> alarms;
+    /// The definition `type_name` names; set by resolve_definitions() when found and
+    /// free of problems.
+    std::shared_ptr<const RawDefinition> definition;
 };
 
 struct RawLine : RawNode {
@@ -229,6 +301,7 @@ struct RawConfig : RawNode {
     RawSeq<RawUpstream> upstreams;
     RawMqtt mqtt;
     RawMetricsHttp metrics_http;
+    FieldList<std::string> definitions;  ///< directories of device definition files
 };
 
 }  // namespace fieldbridge::config

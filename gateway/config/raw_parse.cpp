@@ -170,7 +170,7 @@ RawBackoff parse_backoff(const NodeRef& ref, DiagnosticSink& sink) {
 
 RawConfig parse_raw(const YAML::Node& root, DiagnosticSink& sink) {
     const NodeRef root_ref{root, "", to_mark(root.Mark(), Mark{1, 1})};
-    const MapReader map(root_ref, {"gateway", "modbus_tcp", "lines", "upstreams", "mqtt", "metrics_http"}, sink,
+    const MapReader map(root_ref, {"gateway", "modbus_tcp", "lines", "upstreams", "mqtt", "metrics_http", "definitions"}, sink,
                         true);
     RawConfig raw;
     map.fill(raw);
@@ -180,6 +180,8 @@ RawConfig parse_raw(const YAML::Node& root, DiagnosticSink& sink) {
     raw.upstreams = read_seq<RawUpstream>(map, "upstreams", parse_upstream);
     raw.mqtt = parse_mqtt(map.child("mqtt"), sink);
     raw.metrics_http = parse_metrics_http(map.child("metrics_http"), sink);
+    raw.definitions = read_list<std::string>(map, "definitions", "directories of device definition files",
+                                             [](std::string_view text) { return Parsed<std::string>::ok(std::string(text)); });
     return raw;
 }
 

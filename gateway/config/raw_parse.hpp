@@ -19,6 +19,16 @@ namespace fieldbridge::config {
 /// The `lines` section (raw_parse_lines.cpp).
 [[nodiscard]] RawSeq<RawLine> parse_lines(const MapReader& root);
 
+/// One `blocks:` entry (raw_parse_lines.cpp).
+[[nodiscard]] RawBlock parse_block(const NodeRef& ref, DiagnosticSink& sink);
+
+/// `points:` and `alarms:` lists of a device or a definition (raw_parse_points.cpp).
+[[nodiscard]] RawSeq<RawPoint> parse_points(const MapReader& map, std::string_view key);
+[[nodiscard]] RawSeq<RawAlarm> parse_alarms(const MapReader& map, std::string_view key);
+
+/// A device definition file's root node; @p sink reports in that file.
+[[nodiscard]] RawDefinition parse_definition(const YAML::Node& root, std::string file, DiagnosticSink& sink);
+
 /// A `{initial, max}` back-off map.
 [[nodiscard]] RawBackoff parse_backoff(const NodeRef& ref, DiagnosticSink& sink);
 

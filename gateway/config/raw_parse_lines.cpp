@@ -27,6 +27,8 @@ RawPoll parse_poll(const NodeRef& ref, DiagnosticSink& sink) {
     return raw;
 }
 
+}  // namespace
+
 RawBlock parse_block(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref, {"table", "address", "count", "period", "writable"}, sink);
     RawBlock raw;
@@ -39,15 +41,31 @@ RawBlock parse_block(const NodeRef& ref, DiagnosticSink& sink) {
     return raw;
 }
 
+namespace {
+
 RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "type", "address", "unit_id", "max_age", "command_ttl", "delay_before_command",
-                         "queue_limit", "request_gap", "first_request_delay", "poll", "allow_protected", "mqtt_commands", "word_order", "stroke", "blocks"},
+                         "queue_limit", "request_gap", "first_request_delay", "poll", "allow_protected", "mqtt_commands", "word_order", "stroke", "blocks",
+                         "period", "max_gap", "points", "alarms"},
                         sink);
     RawDevice raw;
     map.fill(raw);
     raw.name = read_string(map, "name");
-    raw.type = read_enum(map, "type", core::device_type_names);
+    raw.type_name = read_string(map, "type");
+    if (raw.type_name.has_value()) {
+        // A built-in type's name; any other name is a device definition's, looked up
+        // by resolve_definitions().
+        if (const auto type = core::parse<DeviceType>(*raw.type_name)) {
+            raw.type.value = *type;
+        }
+        raw.type.path = raw.type_name.path;
+        raw.type.mark = raw.type_name.mark;
+    } else {
+        raw.type.path = raw.type_name.path;
+        raw.type.mark = raw.type_name.mark;
+        raw.type.invalid = raw.type_name.invalid;
+    }
     raw.address = read_int(map, "address");
     raw.unit_id = read_int(map, "unit_id");
     raw.max_age = read_duration(map, "max_age");
@@ -62,6 +80,10 @@ RawDevice parse_device(const NodeRef& ref, DiagnosticSink& sink) {
     raw.word_order = read_enum(map, "word_order", core::word_order_names);
     raw.stroke = read_int(map, "stroke");
     raw.blocks = read_seq<RawBlock>(map, "blocks", parse_block);
+    raw.period = read_duration(map, "period");
+    raw.max_gap = read_int(map, "max_gap");
+    raw.points = parse_points(map, "points");
+    raw.alarms = parse_alarms(map, "alarms");
     return raw;
 }
 

@@ -78,6 +78,12 @@ std::string hex16(std::int64_t value) {
     return buffer;
 }
 
+std::string format_number(double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.10g", value);
+    return buffer;
+}
+
 void check_backoff(DiagnosticSink& sink, const RawBackoff& backoff, const Backoff& defaults) {
     const bool initial_ok = backoff.initial.absent() || check_range(sink, backoff.initial, Backoff::range);
     const bool max_ok = backoff.max.absent() || check_range(sink, backoff.max, Backoff::range);

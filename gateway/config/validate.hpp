@@ -9,7 +9,9 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include "config/config.hpp"
@@ -103,6 +105,54 @@ inline bool check_name(DiagnosticSink& sink, const Field<std::string>& field) {
     }
     return true;
 }
+
+// ---- points (validate_points.cpp) -------------------------------------------------
+
+/// A point as far as the other points and the alarms need it.
+struct PointSpan {
+    std::string name;
+    std::string path;  ///< key path in `file`
+    std::string file;
+    int line = 0;
+    const RawPoint* raw = nullptr;
+    core::PointType type = core::PointType::uint16;
+    bool shape_ok = false;  ///< table, address and width valid: the fields below are set
+    RegisterTable table = RegisterTable::holding;
+    bool bit = false;  ///< a `bit:` point
+    std::int64_t first = 0;
+    std::int64_t last = 0;
+};
+
+/// snake_case: [a-z][a-z0-9_]*, 1..64 characters (points and alarms; a JSON field).
+[[nodiscard]] bool is_point_name(std::string_view name) noexcept;
+bool check_point_name(DiagnosticSink& sink, const Field<std::string>& field);
+/// `type:`, or its default: bool for a bit table or with `bit:`, else uint16.
+[[nodiscard]] core::PointType effective_type(const RawPoint& point) noexcept;
+/// Checks each point and its relations to @p earlier (a definition's points when
+/// these are a device's inline ones) and to the points before it; returns @p
+/// earlier with these added.
+[[nodiscard]] std::vector<PointSpan> check_points(const RawSeq<RawPoint>& points, std::vector<PointSpan> earlier,
+                                                  DiagnosticSink& sink);
+/// Checks alarms against @p points; @p earlier are alarm names already used in the
+/// device. Returns @p earlier with these names added.
+std::vector<std::string> check_alarms(const RawSeq<RawAlarm>& alarms, const std::vector<PointSpan>& points,
+                                      std::vector<std::string> earlier, DiagnosticSink& sink);
+/// `equals:` / `not_equals:` of an alarm: a number, or an enum label of @p point.
+[[nodiscard]] std::optional<double> alarm_value(const Field<std::string>& field, const RawPoint& point);
+
+/// `blocks:`: limits, read-only tables, and no overlap with each other nor with
+/// @p earlier (a definition's blocks; may be null) (validate_devices.cpp).
+void check_blocks(const RawSeq<RawBlock>& blocks, const RawSeq<RawBlock>* earlier, DiagnosticSink& sink);
+
+/// A definition's name (its file's stem): [a-z0-9][a-z0-9_-]*, 1..64 characters.
+[[nodiscard]] bool is_definition_name(std::string_view name) noexcept;
+
+/// A device definition on its own: its keys, points, alarms, blocks and identify
+/// read; @p stem is its file name without `.yaml` (validate_definition.cpp).
+void validate_definition(const RawDefinition& definition, std::string_view stem, DiagnosticSink& sink);
+
+/// A number as written in messages: 21.5, 1e+06.
+[[nodiscard]] std::string format_number(double value);
 
 /// Checks a back-off map: both durations in Backoff::range and initial <= max
 /// (@p defaults stand in for absent values).

@@ -38,8 +38,9 @@ void check_address(const RawDevice& device, DiagnosticSink& sink) {
     }
 }
 
-void check_blocks(const RawDevice& device, DiagnosticSink& sink) {
-    const auto& blocks = device.blocks;
+}  // namespace
+
+void check_blocks(const RawSeq<RawBlock>& blocks, const RawSeq<RawBlock>* earlier, DiagnosticSink& sink) {
     struct Span {
         RegisterTable table;
         std::int64_t first;
@@ -47,6 +48,12 @@ void check_blocks(const RawDevice& device, DiagnosticSink& sink) {
         std::string path;
     };
     std::vector<Span> valid;  // blocks already checked, for the overlap test
+    if (earlier != nullptr) {
+        for (const RawBlock& block : earlier->items) {  // a valid definition's
+            valid.push_back(Span{*block.table, *block.address, *block.address + *block.count - 1,
+                                 block.path + " of the definition"});
+        }
+    }
     for (std::size_t i = 0; i < blocks.items.size(); ++i) {
         const RawBlock& block = blocks.items[i];
         if (!block.ok()) {
@@ -99,6 +106,25 @@ void check_blocks(const RawDevice& device, DiagnosticSink& sink) {
     }
 }
 
+namespace {
+
+/// `points:`, `alarms:`, `max_gap` and `period` of a generic device, with the
+/// definition's (already checked in its own file) as the earlier ones.
+void check_point_keys(const RawDevice& device, DiagnosticSink& sink) {
+    const RawDefinition* definition = device.definition.get();
+    std::vector<PointSpan> earlier;
+    std::vector<std::string> alarm_names;
+    if (definition != nullptr) {
+        DiagnosticSink scratch(definition->file);  // the definition is valid: nothing is reported
+        earlier = check_points(definition->points, {}, scratch);
+        alarm_names = check_alarms(definition->alarms, earlier, {}, scratch);
+    }
+    const auto points = check_points(device.points, std::move(earlier), sink);
+    (void)check_alarms(device.alarms, points, std::move(alarm_names), sink);
+    check_range(sink, device.max_gap, DeviceConfig::max_gap_range);
+    check_range(sink, device.period, RegisterBlock::period_range);
+}
+
 /// Keys that only some types have.
 void check_type_specific(const RawDevice& device, DiagnosticSink& sink) {
     if (!device.type.has_value()) {
@@ -119,27 +145,43 @@ void check_type_specific(const RawDevice& device, DiagnosticSink& sink) {
         sink.error(device.stroke, "stroke applies only to wtec-ascii devices" + of_type + "; remove it");
     }
     if (type == DeviceType::modbus) {
-        if (device.blocks.absent()) {
-            sink.error(device.blocks, "required key is missing; a generic modbus device needs its register blocks, "
-                                      "e.g. blocks: [{table: holding, address: 0x0000, count: 10}]");
-        } else if (device.blocks.ok() && device.blocks.items.empty()) {
-            sink.error(device.blocks, "is empty; a generic modbus device needs at least one register block");
+        const bool has_points = device.points.ok() && !device.points.items.empty();
+        if (device.definition == nullptr && !has_points) {
+            if (device.blocks.absent()) {
+                sink.error(device.blocks, "required key is missing; a generic modbus device needs points or register "
+                                          "blocks, e.g. points: [{name: voltage, table: input, address: 0x0000}] or "
+                                          "blocks: [{table: holding, address: 0x0000, count: 10}]");
+            } else if (device.blocks.ok() && device.blocks.items.empty()) {
+                sink.error(device.blocks, "is empty; a generic modbus device needs points or at least one register "
+                                          "block");
+            }
         }
         if (!device.poll.absent()) {
-            sink.error(device.poll, "generic modbus devices are polled per block; set blocks[].period instead");
+            sink.error(device.poll, "generic modbus devices are polled per point and block; set period (the "
+                                    "points' default), points[].period or blocks[].period instead");
         }
-    } else if (!device.blocks.absent()) {
-        sink.error(device.blocks, "blocks apply only to generic modbus devices" + of_type +
-                                      "; the register map of this type is built in");
+        check_point_keys(device, sink);
+    } else {
+        if (!device.blocks.absent()) {
+            sink.error(device.blocks, "blocks apply only to generic modbus devices" + of_type +
+                                          "; the register map of this type is built in");
+        }
+        const std::string generic_only = " apply only to generic modbus devices and device definitions" + of_type +
+                                         "; remove them";
+        if (!device.points.absent()) sink.error(device.points, "points" + generic_only);
+        if (!device.alarms.absent()) sink.error(device.alarms, "alarms" + generic_only);
+        if (device.max_gap.has_value()) sink.error(device.max_gap, "max_gap" + generic_only);
+        if (device.period.has_value()) sink.error(device.period, "period" + generic_only);
     }
-    check_blocks(device, sink);
+    check_blocks(device.blocks, device.definition ? &device.definition->blocks : nullptr, sink);
 }
 
 void check_device(const RawDevice& device, std::chrono::milliseconds line_response_timeout, DiagnosticSink& sink) {
     if (require(sink, device.name, "a device name such as gripper-1")) {
         check_name(sink, device.name);
     }
-    require(sink, device.type, "one of hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii, modbus");
+    require(sink, device.type_name,
+            "one of hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii, modbus, or the name of a device definition");
     if (require(sink, device.address, "the device's bus address")) {
         check_address(device, sink);
     }

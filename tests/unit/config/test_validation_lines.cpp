@@ -101,7 +101,8 @@ TEST_CASE("type-specific keys") {
                       "lines[0].devices[0].poll", 10, 15, "blocks[].period");
     }
     SUBCASE("unknown type") {
-        CHECK_REPORTS(one_device("hiwin_xeg", "3"), "lines[0].devices[0].type", 7, 15, "'hiwin_xeg' is not allowed",
+        CHECK_REPORTS(one_device("hiwin_xeg", "3"), "lines[0].devices[0].type", 7, 15, "'hiwin_xeg' is not a built-in type",
+                      "did you mean 'hiwin-xeg'?", "no device definition hiwin_xeg.yaml was found",
                       "hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii, modbus");
     }
 }

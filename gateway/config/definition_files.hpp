@@ -1,0 +1,32 @@
+#pragma once
+/// @file definition_files.hpp
+/// Reading device definition files for the loader: the raw definition of a file
+/// with its own problems, and the lookup of every device's `type:` that is not a
+/// built-in type. Internal to the config layer.
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "config/diagnostic_sink.hpp"
+#include "config/raw_config.hpp"
+
+namespace fieldbridge::config {
+
+/// Reads, parses and checks @p file (an absolute path). Its problems are added to
+/// @p problems, in its file; returns null when there is one.
+[[nodiscard]] std::shared_ptr<const RawDefinition> read_definition(const std::filesystem::path& file,
+                                                                   std::vector<Diagnostic>& problems);
+
+/// For every device whose `type:` is not a built-in type: finds the definition in
+/// the configuration's `definitions:` directories (relative to @p base_dir; the
+/// defaults when absent), reads it once per name, and sets the device's `definition`
+/// and `type` (modbus). A name not found, or a definition with problems, is reported
+/// (the device's `type` is then marked invalid, so nothing else reports it again).
+void resolve_definitions(RawConfig& raw, const std::filesystem::path& base_dir, DiagnosticSink& sink);
+
+/// The directories `definitions:` names, resolved against @p base_dir, or the defaults.
+[[nodiscard]] std::vector<std::filesystem::path> definition_dirs(const RawConfig& raw,
+                                                                 const std::filesystem::path& base_dir);
+
+}  // namespace fieldbridge::config

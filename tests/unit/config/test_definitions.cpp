@@ -1,0 +1,275 @@
+// Device definition files (docs/devices.md): the `definitions:` search, a device
+// naming one with `type:`, inline points added to it, problems in a definition
+// reported at file:line:col of that file, and the public loaders the simulator and
+// scan use.
+
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "config/device_definition.hpp"
+#include "config_test_support.hpp"
+#include "temp_dir.hpp"
+
+using namespace fieldbridge::config;
+using namespace fieldbridge::config::test;
+using fieldbridge::core::AlarmCondition;
+using fieldbridge::core::PointType;
+using namespace std::chrono_literals;
+
+namespace {
+
+void write_file(const std::filesystem::path& file, std::string_view text) {
+    std::filesystem::create_directories(file.parent_path());
+    std::ofstream(file, std::ios::binary) << yaml_text(text);
+}
+
+/// A thermostat-like definition (the worked example of docs/devices.md, smaller).
+constexpr std::string_view thermostat = R"(
+name: thermostat
+description: A room thermostat
+word_order: low_first
+period: 2s
+max_gap: 4
+points:
+  - {name: temperature, table: input, address: 0x0000, type: float32, unit: degC}
+  - {name: runtime, table: input, address: 0x0002, type: int32, unit: s}
+  - {name: mode, table: holding, address: 0x0010, writable: true, enum: {0: off, 1: heat, 2: cool}}
+  - {name: status, table: input, address: 0x0004}
+  - {name: setpoint, table: holding, address: 0x0011, type: int16, scale: 0.1, writable: true, min: 5, max: 30}
+alarms:
+  - {name: sensor_fault, point: status, bit: 0, severity: error, text: Sensor broken}
+blocks:
+  - {table: holding, address: 0x0100, count: 2}
+identify: {table: input, address: 0x00F0, count: 2, expect: [0x5448, 1]}
+)";
+
+/// A configuration in @p dir with one device of type @p type; @p extra follows the
+/// device (line 11 on) and @p top is added at the top level (first lines).
+std::string config_text(std::string_view type, std::string_view extra = "", std::string_view top = "") {
+    return std::string(top) +
+           "gateway: {id: t}\n"
+           "lines:\n"
+           "  - name: a\n"
+           "    port: /dev/ttyS0\n"
+           "    devices:\n"
+           "      - name: d\n"
+           "        type: " + std::string(type) + "\n"
+           "        address: 3\n"
+           "        unit_id: 1\n" + std::string(extra);
+}
+
+std::vector<Diagnostic> diagnostics_in(const std::filesystem::path& config_file, std::string_view text) {
+    write_file(config_file, text);
+    try {
+        (void)load_config_file(config_file);
+        return {};
+    } catch (const ConfigError& e) {
+        return e.diagnostics();
+    }
+}
+
+std::shared_ptr<const Config> load_in(const std::filesystem::path& config_file, std::string_view text) {
+    write_file(config_file, text);
+    try {
+        return load_config_file(config_file);
+    } catch (const ConfigError& e) {
+        FAIL("expected the config to load, got:\n" << e.what());
+    }
+    return nullptr;
+}
+
+/// The one diagnostic of @p file at @p line : @p column that says every fragment.
+void require_diagnostic(const std::vector<Diagnostic>& diagnostics, const std::filesystem::path& file, int line,
+                        int column, std::initializer_list<std::string_view> fragments) {
+    INFO("diagnostics:\n" << dump(diagnostics));
+    bool found = false;
+    for (const auto& d : diagnostics) {
+        bool all = d.file == file.string() && d.line == line && d.column == column;
+        for (const auto fragment : fragments) {
+            all = all && d.message.find(fragment) != std::string::npos;
+        }
+        found = found || all;
+    }
+    CHECK_MESSAGE(found, "no diagnostic at " << file.string() << ":" << line << ":" << column);
+}
+
+}  // namespace
+
+TEST_CASE("a device of a definition: the definition's points, then the inline ones, with their defaults") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    write_file(dir.path() / "devices" / "thermostat.yaml", thermostat);
+    const auto config = load_in(dir.path() / "gw.yaml", config_text("thermostat",
+                                                                     "        period: 500ms\n"
+                                                                     "        points: [{name: extra, table: holding, address: 0x0020, type: uint32}]\n"
+                                                                     "        alarms: [{name: too_cold, point: temperature, below: 5}]\n"
+                                                                     "        blocks: [{table: coils, address: 0, count: 8}]\n",
+                                                                     "definitions: [devices]\n"));
+    const DeviceConfig& device = config->lines.at(0).devices.at(0);
+    CHECK(device.type == DeviceType::modbus);
+    CHECK(device.type_name == "thermostat");
+    CHECK(device.definition_file == (dir.path() / "devices" / "thermostat.yaml").string());
+    CHECK(device.word_order == WordOrder::low_first);  // the definition's
+    CHECK(device.period == 500ms);                     // the device's over the definition's
+    const auto& model = device.points;
+    CHECK(model.max_gap == 4);
+    REQUIRE(model.points.size() == 6);
+    CHECK(model.points[0].name == "temperature");
+    CHECK(model.points[0].word_order == WordOrder::low_first);
+    CHECK(model.points[0].period == 500ms);
+    CHECK(model.points[4].min == 5);
+    CHECK(model.points[4].scale == 0.1);
+    CHECK(model.points[5].name == "extra");
+    CHECK(model.points[5].word_order == WordOrder::low_first);
+    REQUIRE(model.alarms.size() == 2);
+    CHECK(model.alarms[0].name == "sensor_fault");
+    CHECK(model.alarms[0].condition == AlarmCondition::bit);
+    CHECK(model.alarms[1].name == "too_cold");
+    REQUIRE(device.blocks.size() == 2);  // the definition's, then the device's
+    CHECK(device.blocks[0].address == 0x0100);
+    CHECK(device.blocks[0].period == 500ms);
+    CHECK(device.blocks[1].table == RegisterTable::coils);
+}
+
+TEST_CASE("definitions: the first directory that has the file wins; relative to the config's folder") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    write_file(dir.path() / "site" / "thermostat.yaml",
+               "name: thermostat\npoints: [{name: only_site, table: input, address: 0}]\n");
+    write_file(dir.path() / "shipped" / "thermostat.yaml", thermostat);
+    write_file(dir.path() / "shipped" / "meter.yaml", "name: meter\npoints: [{name: kwh, table: input, address: 0}]\n");
+    const auto config = load_in(dir.path() / "conf" / "gw.yaml",
+                                config_text("thermostat", "", "definitions: [../site, " +
+                                                                  (dir.path() / "shipped").string() + "]\n"));
+    const auto& device = config->lines.at(0).devices.at(0);
+    REQUIRE(device.points.points.size() == 1);
+    CHECK(device.points.points[0].name == "only_site");
+    CHECK(device.definition_file == (dir.path() / "site" / "thermostat.yaml").string());
+
+    std::vector<Diagnostic> problems;
+    const auto all = load_definitions({dir.path() / "site", dir.path() / "missing", dir.path() / "shipped"}, problems);
+    CHECK(problems.empty());
+    REQUIRE(all.size() == 2);
+    CHECK(all[0].name == "thermostat");
+    CHECK(all[0].points.points.at(0).name == "only_site");
+    CHECK(all[1].name == "meter");
+}
+
+TEST_CASE("a type with no definition says which directories were searched, in order") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    std::filesystem::create_directories(dir.path() / "a");
+    const auto file = dir.path() / "gw.yaml";
+    const auto diagnostics = diagnostics_in(file, config_text("acme-th20", "", "definitions: [a, b]\n"));
+    require_diagnostic(diagnostics, file, 8, 15,
+                       {"'acme-th20' is not a built-in type", "no device definition acme-th20.yaml was found",
+                        "searched, in this order: " + (dir.path() / "a").string() + ", " +
+                            (dir.path() / "b").string() + " (no such directory)"});
+    // Without definitions: the defaults, site first.
+    CHECK_REPORTS(config_text("acme-th20"), "lines[0].devices[0].type", 7, 15,
+                  "/etc/fieldbridge/devices (no such directory), /usr/share/fieldbridge/devices");
+    CHECK_REPORTS(config_text("Acme TH"), "lines[0].devices[0].type", 7, 15, "neither a built-in type");
+    CHECK_REPORTS(config_text("modbus", "", "definitions: x\n"), "definitions", 1, 14, "expected a list");
+}
+
+TEST_CASE("problems in a definition are reported at file:line:col of the definition") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto definition = dir.path() / "d" / "bad.yaml";
+    write_file(definition, R"(
+name: badly
+points:
+  - {name: t, table: input, address: 0, type: float32}
+  - {name: u, table: input, address: 1, count: 2}
+  - {name: v, table: coils, address: 0, bit: 3}
+  - {name: w, table: holding, address: 9, enum: {one: a}, min: 4, max: 3}
+alarms:
+  - {name: x, point: missing, above: 1}
+identify: {table: coils, address: 0, count: 2, expect: [1]}
+unknown_key: 1
+)");
+    const auto file = dir.path() / "gw.yaml";
+    const auto diagnostics = diagnostics_in(file, config_text("bad", "", "definitions: [d]\n"));
+    require_diagnostic(diagnostics, definition, 1, 7, {"differs from the file name bad.yaml", "expected name: bad"});
+    require_diagnostic(diagnostics, definition, 4, 5, {"'u' (uint16, 0x0001) overlaps 't' (float32"});
+    require_diagnostic(diagnostics, definition, 4, 48, {"count applies only to string points"});
+    require_diagnostic(diagnostics, definition, 5, 46, {"bit applies to holding and input"});
+    require_diagnostic(diagnostics, definition, 6, 50, {"not an integer"});
+    require_diagnostic(diagnostics, definition, 6, 72, {"min <= max"});
+    require_diagnostic(diagnostics, definition, 8, 22, {"no point 'missing'"});
+    require_diagnostic(diagnostics, definition, 9, 19, {"holding or input"});
+    require_diagnostic(diagnostics, definition, 9, 56, {"one value per register"});
+    require_diagnostic(diagnostics, definition, 10, 1, {"unknown key 'unknown_key'"});
+    require_diagnostic(diagnostics, file, 8, 15, {"the device definition", "bad.yaml has problems"});
+    // The configuration's own problems come first, the definition's after them.
+    REQUIRE_FALSE(diagnostics.empty());
+    CHECK(diagnostics.front().file == file.string());
+
+    CHECK_THROWS_AS((void)load_definition_file(definition), ConfigError);
+    try {
+        (void)load_definition_file(definition);
+    } catch (const ConfigError& e) {
+        CHECK(std::string(e.what()).find(definition.string() + ":1:7: name:") != std::string::npos);
+    }
+}
+
+TEST_CASE("a definition that does not parse, is empty, or has nothing to read") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto file = dir.path() / "gw.yaml";
+    write_file(dir.path() / "syntax.yaml", "name: syntax\npoints: [{name: a,\n");
+    auto diagnostics = diagnostics_in(file, config_text("syntax", "", "definitions: [.]\n"));
+    INFO(dump(diagnostics));
+    REQUIRE(diagnostics.size() >= 2);
+    CHECK(diagnostics.back().file == (dir.path() / "syntax.yaml").string());
+    CHECK(diagnostics.back().message.find("YAML syntax error") != std::string::npos);
+    CHECK(diagnostics.back().line > 0);
+
+    write_file(dir.path() / "empty.yaml", "");
+    diagnostics = diagnostics_in(file, config_text("empty", "", "definitions: [.]\n"));
+    require_diagnostic(diagnostics, dir.path() / "empty.yaml", 1, 1, {"the device definition is empty"});
+
+    write_file(dir.path() / "nothing.yaml", "name: nothing\ndescription: no points\n");
+    diagnostics = diagnostics_in(file, config_text("nothing", "", "definitions: [.]\n"));
+    require_diagnostic(diagnostics, dir.path() / "nothing.yaml", 1, 1, {"needs points (or blocks)"});
+}
+
+TEST_CASE("inline points add to the definition's: a clash of names or registers is an error in the config") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    write_file(dir.path() / "thermostat.yaml", thermostat);
+    const auto file = dir.path() / "gw.yaml";
+    const auto definition = (dir.path() / "thermostat.yaml").string();
+    auto diagnostics = diagnostics_in(file, config_text("thermostat",
+                                                        "        points:\n"
+                                                        "          - {name: mode, table: holding, address: 0x0200}\n"
+                                                        "          - {name: half, table: input, address: 0x0001}\n"
+                                                        "        alarms: [{name: sensor_fault, point: half, above: 1}]\n"
+                                                        "        blocks: [{table: holding, address: 0x0101, count: 1}]\n",
+                                                        "definitions: [.]\n"));
+    require_diagnostic(diagnostics, file, 12, 20,
+                       {"'mode' is already used by points[2] (" + definition + ":9)"});
+    require_diagnostic(diagnostics, file, 13, 13, {"'half' (uint16, 0x0001) overlaps 'temperature'"});
+    require_diagnostic(diagnostics, file, 14, 25, {"'sensor_fault' is already used"});
+    require_diagnostic(diagnostics, file, 15, 18, {"overlaps blocks[0] of the definition"});
+}
+
+TEST_CASE("load_definition_file gives the definition with its defaults") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    write_file(dir.path() / "thermostat.yaml", thermostat);
+    const auto definition = load_definition_file(dir.path() / "thermostat.yaml");
+    CHECK(definition.name == "thermostat");
+    CHECK(definition.description == "A room thermostat");
+    CHECK(definition.period == 2s);
+    CHECK(definition.word_order == WordOrder::low_first);
+    REQUIRE(definition.points.points.size() == 5);
+    CHECK(definition.points.points[0].type == PointType::float32);
+    CHECK(definition.points.points[0].period == 2s);
+    CHECK(definition.points.points[0].word_order == WordOrder::low_first);
+    REQUIRE(definition.blocks.size() == 1);
+    CHECK(definition.blocks[0].period == 2s);
+    REQUIRE(definition.identify.has_value());
+    CHECK(definition.identify->table == RegisterTable::input);
+    CHECK(definition.identify->address == 0x00F0);
+    CHECK(definition.identify->count == 2);
+    CHECK(definition.identify->expect == std::vector<std::uint16_t>{0x5448, 1});
+    CHECK_THROWS_AS((void)load_definition_file(dir.path() / "missing.yaml"), ConfigError);
+}
