@@ -164,7 +164,7 @@ void DeviceAgent::Impl::on_block_rejected(std::uint32_t id, TimePoint now) {
     if (split.empty()) {
         log(LogLevel::warning, who() + " refused to read " + old +
                                    " even alone (exception 0x02): it is not polled any more; check the "
-                                   "device's register map or the configured blocks");
+                                   "device's register map, or the blocks and points configured for it");
         return;
     }
     std::string halves;

@@ -280,7 +280,7 @@ PointValue decode(const PointDef& point, std::span<const std::uint16_t> register
     const std::uint16_t first = registers.empty() ? std::uint16_t{0} : registers.front();
     if (point.is_bool()) {
         if (is_bit_point(point)) {
-            return ((first >> *point.bit) & 1U) != 0;
+            return *point.bit < 16 && ((first >> *point.bit) & 1U) != 0;
         }
         return first != 0;
     }
@@ -325,6 +325,9 @@ Encoded encode(const PointDef& point, const PointValue& value) {
             return refused("it takes true or false, not " + std::string{kind_of(value)});
         }
         if (is_bit_point(point)) {
+            if (*point.bit > 15) {
+                return refused("its bit " + std::to_string(*point.bit) + " is outside 0-15");
+            }
             return Encoded{{static_cast<std::uint16_t>(*b ? 1U << *point.bit : 0U)}, {}};
         }
         return Encoded{{static_cast<std::uint16_t>(*b ? 1 : 0)}, {}};
