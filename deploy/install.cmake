@@ -50,10 +50,14 @@ install(FILES "${_fb_deploy}/man/fieldbridge.8" DESTINATION "${CMAKE_INSTALL_MAN
 install(FILES "${_fb_deploy}/man/fieldbridge.yaml.5" DESTINATION "${CMAKE_INSTALL_MANDIR}/man5"
         COMPONENT daemon)
 install(FILES README.md docs/architecture.md docs/configuration.md docs/modbus-tcp.md docs/mqtt.md
-              docs/protocols.md docs/r6-passthrough.md docs/registers.md docs/service.md
+              docs/protocols.md docs/r6-passthrough.md docs/registers.md docs/service.md docs/devices.md
         DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/fieldbridge" COMPONENT daemon)
 install(FILES config/fieldbridge.example.yaml DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/fieldbridge/examples"
         COMPONENT daemon)
+# The shipped device definitions (docs/devices.md): the last of the default
+# `definitions:` directories, after the site's /etc/fieldbridge/devices.
+install(DIRECTORY config/devices/ DESTINATION "${CMAKE_INSTALL_DATADIR}/fieldbridge/devices" COMPONENT daemon
+        FILES_MATCHING PATTERN "*.yaml")
 
 if(TARGET fieldbridge-sim)
   install(FILES "${_fb_deploy}/man/fieldbridge-sim.1" DESTINATION "${CMAKE_INSTALL_MANDIR}/man1"

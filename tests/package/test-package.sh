@@ -140,6 +140,19 @@ check "fieldbridge --version" contains "$(fieldbridge --version)" "^fieldbridge 
 check "fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml (as user fieldbridge): exit 0" \
   as_root runuser -u fieldbridge -- /usr/bin/fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml
 check "fieldbridge-sim --help" /usr/bin/fieldbridge-sim --help
+check "installed: the shipped device definitions in /usr/share/fieldbridge/devices" \
+  test -f /usr/share/fieldbridge/devices/example-thermostat.yaml
+check "docs: the definition guide devices.md in /usr/share/doc/fieldbridge" \
+  contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/devices\.md'
+# A device of a shipped definition, with no definitions: key: found in the default
+# directories (docs/devices.md).
+definition_config="$(mktemp /tmp/fb-package-definition-XXXXXX.yaml)"
+printf '%s\n' 'gateway: {id: pkg}' 'lines:' '  - name: a' '    port: /dev/ttyS0' '    devices:' \
+  '      - {name: room, type: example-thermostat, address: 7, unit_id: 1}' > "$definition_config"
+chmod 0644 "$definition_config"
+check "fieldbridge --check-config: type example-thermostat found in /usr/share/fieldbridge/devices" \
+  as_root runuser -u fieldbridge -- /usr/bin/fieldbridge --check-config "$definition_config"
+rm -f "$definition_config"
 # Spec section 7 on the shipped build: reloads leave a running line's idle time within
 # one transaction of its normal idle time (the same test runs in ctest with the
 # sanitizer build's looser bounds).

@@ -40,8 +40,11 @@ std::unique_ptr<BusDevice> make_device(std::string_view type, std::uint8_t addre
     if (type == type_wtec_rtu) return make_wtec_rtu(address, options.wtec_stroke);
     if (type == type_wtec_ascii) return make_wtec_ascii(address, options.wtec_stroke);
     if (type == type_generic) return make_generic_modbus(address);
+    if (options.definition && type == options.definition->name) {
+        return std::make_unique<DefinitionModel>(address, options.definition);
+    }
     throw std::invalid_argument("unknown simulated device type \"" + std::string(type) +
-                                "\"; use hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii or modbus");
+                                "\"; use hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii, modbus or a device definition (--definitions, --definition)");
 }
 
 }  // namespace fieldbridge::sim

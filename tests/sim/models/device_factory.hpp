@@ -1,7 +1,8 @@
 #pragma once
 /// @file device_factory.hpp
 /// Builds a simulated bus device from its type name, as used by the simulator
-/// configuration and command line ("hiwin-xeg", "excd203mb", "wtec-rtu", "wtec-ascii", "modbus").
+/// configuration and command line ("hiwin-xeg", "excd203mb", "wtec-rtu", "wtec-ascii",
+/// "modbus", or the name of a device definition given in the options).
 
 #include <cstdint>
 #include <memory>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "models/bus_device.hpp"
+#include "models/definition_model.hpp"
 
 namespace fieldbridge::sim {
 
@@ -24,6 +26,9 @@ struct DeviceOptions {
     /// EXCD203MB 32-bit register word order: "high_first" (default, as the CRC-verified
     /// solm+ example of manual 002 shows) or "low_first".
     std::string excd_word_order = "high_first";
+    /// Set when the device's type names a device definition (--definitions,
+    /// --definition): make_device() then builds a DefinitionModel of it.
+    std::shared_ptr<const DefinitionSpec> definition;
 };
 
 /// The type names make_device() accepts.

@@ -16,13 +16,23 @@ namespace {
 constexpr std::string_view footer = R"(
 BUS SPEC (--bus, repeatable)
   PATH:TYPE@ADDR[/KEY=VALUE...][,TYPE@ADDR...]
-  TYPE: hiwin-xeg | excd203mb | wtec-rtu | wtec-ascii. Modbus-RTU and WTEC ASCII
+  TYPE: hiwin-xeg | excd203mb | wtec-rtu | wtec-ascii | modbus, or the name of a
+  device definition (see DEFINITIONS). Modbus-RTU and WTEC ASCII
   devices may share a bus: a frame starting with '>' is ASCII, anything else RTU.
   Per-device keys: model=0x0A20 (hiwin-xeg), stroke=20000 (wtec-*),
   word-order=high_first|low_first (excd203mb).
   The pty's slave side is linked at PATH (directory created, stale link replaced,
   link removed on exit); the bus is named after the file name (line-a).
   e.g. --bus /tmp/x/line-a:hiwin-xeg@2,excd203mb@3,wtec-ascii@5 --bus /tmp/x/line-b:wtec-rtu@1
+
+DEFINITIONS (--definitions DIR, --definition FILE, both repeatable)
+  A TYPE that is not built in names a device definition (docs/devices.md): a
+  --definition FILE named TYPE.yaml, else TYPE.yaml in the first --definitions DIR
+  that has one. The device has exactly the registers and coils of the definition's
+  points and blocks (02 elsewhere), all 0 at start; control commands
+  "device ADDR set POINT VALUE" (engineering units, enum label, true/false, text)
+  and "device ADDR set-register TABLE ADDRESS VALUE..." change them.
+  e.g. --definitions config/devices --bus /tmp/x/line-a:thermostat-example@7
 
 WIRE TIME (--wire-time)
   A pty moves bytes instantly; with --wire-time the simulator delivers each reply
@@ -169,6 +179,9 @@ void add_options(CLI::App& app, RawOptions& raw) {
         ->capture_default_str();
     app.add_option("--excd-word-order", raw.excd_word_order, "Default 32-bit word order of excd203mb devices: high_first or low_first")
         ->capture_default_str();
+    app.add_option("--definitions", raw.definition_dirs,
+                   "A directory of device definition files NAME.yaml (repeatable; the first that has a name wins)");
+    app.add_option("--definition", raw.definition_files, "A device definition file NAME.yaml (repeatable)");
     app.add_option("--log-level", raw.log_level, "trace, debug, info, warn, error")->capture_default_str();
     app.footer(std::string(footer));
 }
@@ -243,6 +256,7 @@ SimOptions build_options(const RawOptions& raw) {
         }
         options.buses.push_back(std::move(bus));
     }
+    attach_definitions(options.buses, raw.definition_dirs, raw.definition_files);
     if (!raw.r6.empty()) {
         options.r6 = parse_endpoint(raw.r6, "--r6");
     }

@@ -74,6 +74,8 @@ struct RawOptions {
     std::uint32_t wtec_stroke = DeviceOptions{}.wtec_stroke;
     std::string excd_word_order = DeviceOptions{}.excd_word_order;
     std::string log_level = "info";
+    std::vector<std::string> definition_dirs;   ///< --definitions
+    std::vector<std::string> definition_files;  ///< --definition
 };
 
 /// Declares every option on @p app, bound to @p raw, with its --help text.
@@ -84,6 +86,14 @@ void add_options(CLI::App& app, RawOptions& raw);
 
 /// "PATH:TYPE@ADDR[/key=value...],TYPE@ADDR..." (keys: model, stroke, word-order).
 [[nodiscard]] BusSpec parse_bus_spec(std::string_view text, const DeviceOptions& defaults);
+
+/// Gives every device of @p buses whose type is not a built-in model the device
+/// definition of that name: a file of @p files whose name is NAME.yaml, else
+/// NAME.yaml in the first of @p dirs that has it (sim_definitions.cpp). Throws
+/// SimError naming the device and what was searched, or the definition's problems
+/// (file:line:col).
+void attach_definitions(std::vector<BusSpec>& buses, const std::vector<std::string>& dirs,
+                        const std::vector<std::string>& files);
 
 /// "HOST:PORT" (IPv4 or bracketed IPv6).
 [[nodiscard]] Endpoint parse_endpoint(std::string_view text, std::string_view what);

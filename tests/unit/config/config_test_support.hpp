@@ -34,6 +34,22 @@ inline std::vector<Diagnostic> diagnostics_of(std::string_view yaml, const std::
     }
 }
 
+/// A configuration of one line with one device `d` of @p type at address 3, unit 1:
+/// @p top first (top-level keys), then the device, whose keys end on line 9 (plus
+/// the lines of @p top); @p extra continues the device (at its indentation, 8 spaces).
+inline std::string one_device_config(std::string_view type, std::string_view extra = "", std::string_view top = "") {
+    return std::string(top) +
+           "gateway: {id: t}\n"
+           "lines:\n"
+           "  - name: a\n"
+           "    port: /dev/ttyS0\n"
+           "    devices:\n"
+           "      - name: d\n"
+           "        type: " + std::string(type) + "\n"
+           "        address: 3\n"
+           "        unit_id: 1\n" + std::string(extra);
+}
+
 inline std::string dump(const std::vector<Diagnostic>& diagnostics) {
     std::string out;
     for (const auto& d : diagnostics) {

@@ -5,6 +5,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -47,19 +48,10 @@ blocks:
 identify: {table: input, address: 0x00F0, count: 2, expect: [0x5448, 1]}
 )";
 
-/// A configuration in @p dir with one device of type @p type; @p extra follows the
-/// device (line 11 on) and @p top is added at the top level (first lines).
+/// The configuration of one device of type @p type (config_test_support.hpp): the
+/// device's `type` on line 8 when @p top is one line.
 std::string config_text(std::string_view type, std::string_view extra = "", std::string_view top = "") {
-    return std::string(top) +
-           "gateway: {id: t}\n"
-           "lines:\n"
-           "  - name: a\n"
-           "    port: /dev/ttyS0\n"
-           "    devices:\n"
-           "      - name: d\n"
-           "        type: " + std::string(type) + "\n"
-           "        address: 3\n"
-           "        unit_id: 1\n" + std::string(extra);
+    return one_device_config(type, extra, top);
 }
 
 std::vector<Diagnostic> diagnostics_in(const std::filesystem::path& config_file, std::string_view text) {
@@ -272,4 +264,27 @@ TEST_CASE("load_definition_file gives the definition with its defaults") {
     CHECK(definition.identify->count == 2);
     CHECK(definition.identify->expect == std::vector<std::uint16_t>{0x5448, 1});
     CHECK_THROWS_AS((void)load_definition_file(dir.path() / "missing.yaml"), ConfigError);
+}
+
+TEST_CASE("the shipped definitions (config/devices) load without a problem; the worked example as documented") {
+    std::vector<Diagnostic> problems;
+    const auto shipped = load_definitions({FIELDBRIDGE_SHIPPED_DEFINITIONS}, problems);
+    INFO(dump(problems));
+    CHECK(problems.empty());
+    const auto example = std::find_if(shipped.begin(), shipped.end(),
+                                      [](const DeviceDefinition& d) { return d.name == "example-thermostat"; });
+    REQUIRE(example != shipped.end());
+    const auto& points = example->points.points;
+    REQUIRE(points.size() == 6);
+    CHECK(points[0].type == PointType::float32);
+    CHECK(points[1].type == PointType::int32);
+    CHECK(points[1].period == 10s);
+    CHECK(points[3].labels.size() == 4);
+    CHECK(points[4].writable);
+    CHECK(points[4].min == 5);
+    CHECK(points[4].max == 30);
+    REQUIRE(example->points.alarms.size() == 2);
+    CHECK(example->points.alarms[0].condition == AlarmCondition::bit);
+    REQUIRE(example->identify.has_value());
+    CHECK(example->identify->expect == std::vector<std::uint16_t>{0x5448});
 }

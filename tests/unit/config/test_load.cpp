@@ -67,6 +67,9 @@ TEST_CASE("the example configuration loads and uses every section") {
     CHECK(line.devices[3].type == DeviceType::modbus);
     CHECK(line.devices[3].blocks.size() == 3);
     CHECK(line.devices[3].word_order == WordOrder::low_first);
+    CHECK(line.devices[3].points.points.size() == 6);
+    CHECK(line.devices[3].points.alarms.size() == 2);
+    CHECK(line.devices[3].points.points[0].type == fieldbridge::core::PointType::float32);
     CHECK(line.broadcast_unit == UnitId{100});
     CHECK(line.broadcast_share == 10U);
     CHECK(config->lines[1].devices.at(0).type == DeviceType::wtec_rtu);

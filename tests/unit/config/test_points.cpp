@@ -21,15 +21,7 @@ namespace {
 /// One generic device; @p extra is appended to it from line 10 on (at the device's
 /// indentation: "        points:" ...).
 std::string device_with(std::string_view extra, std::string_view type = "modbus") {
-    return "gateway: {id: t}\n"
-           "lines:\n"
-           "  - name: a\n"
-           "    port: /dev/ttyS0\n"
-           "    devices:\n"
-           "      - name: d\n"
-           "        type: " + std::string(type) + "\n"
-           "        address: 3\n"
-           "        unit_id: 1\n" + std::string(extra);
+    return one_device_config(type, extra);
 }
 
 /// device_with() with one point `p` whose keys are @p keys (line 11, keys from column 13).
