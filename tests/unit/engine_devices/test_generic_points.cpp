@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/points/point_requests.hpp"
 #include "engine/profiles/generic_profile.hpp"
 #include "support.hpp"
 
@@ -325,4 +326,28 @@ TEST_CASE("generic points: a model the map cannot hold is refused with a reason"
     CHECK(refusal_of(o).find("alarm 'orphan' is on point 'pressure'") != std::string::npos);
     o.points = {};
     CHECK(refusal_of(o).find("no register blocks and no points") != std::string::npos);
+}
+
+TEST_CASE("generic points: what the point write requests send passes the profile's own checks") {
+    namespace pts = fieldbridge::engine::points;
+    const fe::GenericProfile g{thermo_options()};
+    fe::RegisterImage image;
+    const std::vector<pts::PointWrite> writes{{"setpoint", 30.0},          {"setpoint", std::int64_t{5}},
+                                              {"mode", std::string{"cool"}}, {"eco", true},
+                                              {"keypad_locked", false},      {"limit", -1.5e300},
+                                              {"relay", false}};
+    const pts::PointRequests r = pts::write_requests(g.options().points, writes);
+    REQUIRE(r.ok());
+    REQUIRE(r.requests.size() == writes.size());
+    for (const fp::Request& q : r.requests) {
+        INFO(hex(fp::encode_request(q)));
+        CHECK_FALSE(g.validate(q, image));
+    }
+    // And a fresh read of points is a read the map allows.
+    const std::vector<std::string> names{"temperature", "humidity", "energy", "model_name", "relay", "status"};
+    const pts::PointRequests reads = pts::read_requests(g.options().points, names);
+    REQUIRE(reads.ok());
+    for (const fp::Request& q : reads.requests) {
+        CHECK_FALSE(g.validate(q, image));
+    }
 }
