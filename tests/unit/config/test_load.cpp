@@ -118,10 +118,17 @@ TEST_CASE("the demo configuration describes the demo cell") {
     const auto& b = config->lines[1];
     CHECK(b.name == "line-b");
     CHECK(b.port == "/tmp/fieldbridge-demo/line-b");
-    REQUIRE(b.devices.size() == 1);
+    REQUIRE(b.devices.size() == 2);
     CHECK(b.devices[0].type == DeviceType::wtec_rtu);
     CHECK(b.devices[0].address == BusAddress{1});
     CHECK(b.devices[0].unit_id == UnitId{4});
+    // The shipped example definition, found in config/devices beside the file.
+    CHECK(b.devices[1].type == DeviceType::modbus);
+    CHECK(b.devices[1].type_name == "example-thermostat");
+    CHECK(b.devices[1].address == BusAddress{7});
+    CHECK(b.devices[1].unit_id == UnitId{5});
+    CHECK(b.devices[1].points.points.size() == 6);
+    CHECK(b.devices[1].points.alarms.size() == 2);
 
     REQUIRE(config->upstreams.size() == 1);
     const auto& r6 = config->upstreams[0];
