@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <ostream>
 #include <string_view>
 #include <vector>
 
 #include "config/config.hpp"
+#include "config/device_definition.hpp"
 #include "daemon/exit_codes.hpp"
 #include "engine/posix_serial_port.hpp"
 #include "engine/tcp_stream_port.hpp"
@@ -60,6 +62,29 @@ constexpr std::chrono::milliseconds scan_connect_timeout{2000};
     return std::to_string(o.baud) + " bit/s, 8" + std::string(1, core::parity_letter(o.parity)) + std::to_string(o.stop_bits);
 }
 
+/// The identify reads of the definitions in @p dirs (the defaults when empty). A
+/// definition with problems is skipped and each problem reported on @p err: the scan
+/// still runs.
+[[nodiscard]] std::vector<scan::DefinitionIdentify> identify_reads(const std::vector<std::string>& dirs,
+                                                                   std::ostream& err) {
+    std::vector<std::filesystem::path> paths(dirs.begin(), dirs.end());
+    if (paths.empty()) {
+        paths.assign(config::default_definition_dirs.begin(), config::default_definition_dirs.end());
+    }
+    std::vector<config::Diagnostic> problems;
+    const auto definitions = config::load_definitions(paths, problems);
+    for (const auto& problem : problems) {
+        err << "fieldbridge scan: skipping a device definition: " << problem.to_string() << '\n';
+    }
+    std::vector<scan::DefinitionIdentify> reads;
+    for (const auto& definition : definitions) {
+        if (definition.identify) {
+            reads.push_back(scan::DefinitionIdentify{definition.name, *definition.identify});
+        }
+    }
+    return reads;
+}
+
 }  // namespace
 
 ScanCommand::ScanCommand(std::ostream& out, std::ostream& err) : out_(out), err_(err) {}
@@ -104,6 +129,10 @@ void ScanCommand::define(CLI::App& command) {
     command.add_flag("--local-echo", options_.local_echo,
                      "The adapter echoes what it sends (2-wire without echo suppression): discard the echo");
     command.add_flag("--rs485", options_.rs485, "Use the kernel RS-485 mode (TIOCSRS485) of the port");
+    command.add_option("--definitions", options_.definition_dirs,
+                       "Directory of device definitions whose identify reads name what is found (repeatable; "
+                       "default /etc/fieldbridge/devices, /usr/share/fieldbridge/devices)")
+        ->type_name("DIR");
 }
 
 int ScanCommand::run(std::optional<config::LogLevel> log_level) {
@@ -148,6 +177,7 @@ int ScanCommand::run(std::optional<config::LogLevel> log_level) {
         return exit_port_error;
     }
 
+    const auto definitions = identify_reads(options_.definition_dirs, err_);
     err_ << "fieldbridge scan: " << options_.port << " at " << format_of(options_) << ", addresses "
          << options_.first << "-" << options_.last << ", timeout " << options_.timeout_ms << " ms\n";
     scan::ScanResult result;
@@ -155,7 +185,7 @@ int ScanCommand::run(std::optional<config::LogLevel> log_level) {
         scan::LineLink link(*port, timing_of(options_), log_to(err_, log_level));
         scan::LineScanner scanner(
             link, scan::ScanRange{static_cast<std::uint8_t>(options_.first), static_cast<std::uint8_t>(options_.last)},
-            [this](const std::string& text) { err_ << "fieldbridge scan: " << text << '\n'; });
+            [this](const std::string& text) { err_ << "fieldbridge scan: " << text << '\n'; }, definitions);
         result = scanner.run();
     } catch (const engine::SerialPortError& error) {
         err_ << "fieldbridge scan: the scan stopped: " << error.what() << '\n';

@@ -5,6 +5,7 @@
 ///
 ///     fieldbridge scan --port DEV [--baud N] [--parity N|E|O] [--stop-bits 1|2]
 ///                      [--from A] [--to B] [--timeout MS] [--local-echo] [--rs485]
+///                      [--definitions DIR]...
 ///
 /// The port must not be in use: stop a gateway running on it first. Progress and
 /// errors go to the error stream, the snippet to the output stream.
@@ -15,6 +16,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/parity.hpp"
 #include "daemon/command_line.hpp"
@@ -40,6 +42,9 @@ struct ScanOptions {
     unsigned timeout_ms = 50;
     bool local_echo = false;
     bool rs485 = false;
+    /// Directories of device definitions whose `identify:` reads name generic devices;
+    /// empty: the configuration's defaults (config::default_definition_dirs).
+    std::vector<std::string> definition_dirs;
 };
 
 class ScanCommand final : public daemon::Subcommand {

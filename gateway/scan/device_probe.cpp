@@ -20,6 +20,12 @@ namespace {
 /// types apart is their profiles' knowledge (`*_identification()`).
 constexpr engine::IdentificationRead presence{0, 1};
 
+[[nodiscard]] protocol::Request read_of(const core::IdentifyRead& read) {
+    return protocol::ReadRegistersRequest{read.table == core::RegisterTable::input ? protocol::fc::read_input_registers
+                                                                                   : protocol::fc::read_holding_registers,
+                                          read.address, read.count};
+}
+
 [[nodiscard]] protocol::Request read_holding(engine::IdentificationRead read) {
     return protocol::ReadRegistersRequest{protocol::fc::read_holding_registers, read.address, read.count};
 }
@@ -45,7 +51,8 @@ constexpr engine::IdentificationRead presence{0, 1};
 
 }  // namespace
 
-ModbusProbe::ModbusProbe(std::uint8_t address) : address_(address) {}
+ModbusProbe::ModbusProbe(std::uint8_t address, std::vector<DefinitionIdentify> definitions)
+    : address_(address), definitions_(std::move(definitions)) {}
 
 std::optional<protocol::Request> ModbusProbe::next() const {
     switch (step_) {
@@ -53,14 +60,27 @@ std::optional<protocol::Request> ModbusProbe::next() const {
         case Step::xeg_model: return read_holding(engine::xeg_identification());
         case Step::wtec_id: return read_holding(engine::wtec_rtu_identification());
         case Step::excd_version: return read_holding(engine::excd_identification());
+        case Step::definitions: return read_of(definitions_[definition_].read);
         case Step::finished: break;
     }
     return std::nullopt;
 }
 
 void ModbusProbe::identified(engine::DeviceType type, std::string detail) {
-    found_ = FoundDevice{address_, type, std::move(detail), holding_zero_readable_};
+    found_ = FoundDevice{address_, type, std::move(detail), holding_zero_readable_, {}};
     step_ = Step::finished;
+}
+
+void ModbusProbe::try_definitions(std::size_t from) {
+    if (from < definitions_.size()) {
+        definition_ = from;
+        step_ = Step::definitions;
+        return;
+    }
+    identified(engine::DeviceType::modbus,
+               "answers FC03 at " + span_text(presence) + (holding_zero_readable_ ? "" : " with an exception") +
+                   "; not an XEG, WTEC-485 or EXCD203MB" +
+                   (definitions_.empty() ? std::string() : ", nor a device definition's identify read"));
 }
 
 void ModbusProbe::on_reply(const std::optional<protocol::Response>& reply) {
@@ -99,10 +119,23 @@ void ModbusProbe::on_reply(const std::optional<protocol::Response>& reply) {
                            "ver (" + span_text(engine::excd_identification()) + ") reads " + std::to_string(version));
                 return;
             }
-            identified(engine::DeviceType::modbus,
-                       "answers FC03 at " + span_text(presence) + (holding_zero_readable_ ? "" : " with an exception") +
-                           "; not an XEG, WTEC-485 or EXCD203MB");
+            try_definitions(0);
             return;
+        case Step::definitions: {
+            const DefinitionIdentify& candidate = definitions_[definition_];
+            const auto& read = candidate.read;
+            if (values && values->size() == read.count && (read.expect.empty() || *values == read.expect)) {
+                identified(engine::DeviceType::modbus,
+                           "device definition " + candidate.name + ": its identify read (" +
+                               std::string(core::to_string(read.table)) + " " +
+                               span_text(engine::IdentificationRead{read.address, read.count}) +
+                               (read.expect.empty() ? ") is answered" : ") reads the expected values"));
+                found_->definition = candidate.name;
+                return;
+            }
+            try_definitions(definition_ + 1);
+            return;
+        }
         case Step::finished: break;
     }
     throw std::logic_error("ModbusProbe::on_reply after the probe of address " + std::to_string(address_) +

@@ -13,7 +13,11 @@
 ///     (engine::wtec_rtu_identification()) reads the address the device answered from.
 ///  4. EXCD203MB: FC03 of `ver` (engine::excd_identification(), a 32-bit query
 ///     register) is answered with two registers.
-///  5. anything else is a generic Modbus device.
+///  5. device definitions (docs/devices.md): each definition's `identify:` read
+///     (DefinitionIdentify, FC03 / FC04), in the order given; the first whose reply
+///     holds exactly its `expect` values (or, without `expect`, that is answered at
+///     all) names the device.
+///  6. anything else is a generic Modbus device.
 /// The registers are the profiles' (docs/architecture.md, "Device knowledge"); the
 /// probe holds none.
 /// Every request is a read: nothing a scan sends can move or reconfigure a device.
@@ -27,11 +31,18 @@
 #include <string>
 #include <vector>
 
+#include "core/point.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "protocol/bytes.hpp"
 #include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::scan {
+
+/// The identify read of one device definition.
+struct DefinitionIdentify {
+    std::string name;  ///< the definition's name: the device's `type:`
+    core::IdentifyRead read;
+};
 
 /// A device the scan found.
 struct FoundDevice {
@@ -42,13 +53,16 @@ struct FoundDevice {
     /// modbus only: the first holding register answered with a value (so a block
     /// there is known to be readable).
     bool holding_zero_readable = false;
+    /// modbus only: the device definition whose identify read matched ("" when none).
+    std::string definition;
     bool operator==(const FoundDevice&) const = default;
 };
 
 /// The identification sequence of one Modbus-RTU address.
 class ModbusProbe {
 public:
-    explicit ModbusProbe(std::uint8_t address);
+    /// @p definitions are tried in order once the built-in types are ruled out.
+    explicit ModbusProbe(std::uint8_t address, std::vector<DefinitionIdentify> definitions = {});
 
     /// The read to send next; nullopt when the probe is finished.
     [[nodiscard]] std::optional<protocol::Request> next() const;
@@ -61,11 +75,15 @@ public:
     [[nodiscard]] const std::optional<FoundDevice>& result() const noexcept { return found_; }
 
 private:
-    enum class Step : std::uint8_t { presence, xeg_model, wtec_id, excd_version, finished };
+    enum class Step : std::uint8_t { presence, xeg_model, wtec_id, excd_version, definitions, finished };
 
     void identified(engine::DeviceType type, std::string detail);
+    /// No built-in type: the definitions' identify reads, then a generic device.
+    void try_definitions(std::size_t from);
 
     std::uint8_t address_;
+    std::vector<DefinitionIdentify> definitions_;
+    std::size_t definition_ = 0;  ///< Step::definitions: the one being tried
     Step step_ = Step::presence;
     bool holding_zero_readable_ = false;
     std::optional<FoundDevice> found_;

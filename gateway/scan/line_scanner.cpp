@@ -22,13 +22,15 @@ constexpr auto more_stations_limit = std::chrono::milliseconds{500};
 constexpr unsigned progress_every = 50;
 
 [[nodiscard]] std::string describe(const FoundDevice& d) {
-    return "address " + std::to_string(d.address) + ": " + std::string{engine::to_string(d.type)} + ", " + d.detail;
+    return "address " + std::to_string(d.address) + ": " +
+           (d.definition.empty() ? std::string{engine::to_string(d.type)} : d.definition) + ", " + d.detail;
 }
 
 }  // namespace
 
-LineScanner::LineScanner(LineLink& link, ScanRange range, Progress progress)
-    : link_(link), range_(range), progress_(std::move(progress)) {}
+LineScanner::LineScanner(LineLink& link, ScanRange range, Progress progress,
+                         std::vector<DefinitionIdentify> definitions)
+    : link_(link), range_(range), progress_(std::move(progress)), definitions_(std::move(definitions)) {}
 
 void LineScanner::report(const std::string& text) const {
     if (progress_) {
@@ -71,7 +73,7 @@ std::vector<FoundDevice> LineScanner::find_ascii_stations(ScanStats& stats) {
         }
         // Confirm with a request addressed to the station alone (a `$` reply can be
         // the only survivor of a collision) and read its firmware text.
-        FoundDevice device{address, engine::DeviceType::wtec_ascii, "answers `$`, but not `A` (read version)", false};
+        FoundDevice device{address, engine::DeviceType::wtec_ascii, "answers `$`, but not `A` (read version)", false, {}};
         const engine::Outcome version = send(engine::AsciiPayload{wtec::ReadVersion{}}, address, stats);
         if (const auto* reply = std::get_if<wtec::Reply>(&version.reply)) {
             if (const auto* text = std::get_if<wtec::Version>(reply)) {
@@ -85,7 +87,7 @@ std::vector<FoundDevice> LineScanner::find_ascii_stations(ScanStats& stats) {
 }
 
 std::optional<FoundDevice> LineScanner::probe_modbus(std::uint8_t address, ScanStats& stats) {
-    ModbusProbe probe(address);
+    ModbusProbe probe(address, definitions_);
     while (const auto request = probe.next()) {
         const engine::Outcome outcome = send(engine::ModbusPayload{*request}, address, stats);
         const auto* response = std::get_if<protocol::Response>(&outcome.reply);

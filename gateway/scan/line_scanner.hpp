@@ -37,7 +37,10 @@ public:
     /// One line of progress text ("address 2: hiwin-xeg, XEG-32 (model <model code>)").
     using Progress = std::function<void(const std::string&)>;
 
-    LineScanner(LineLink& link, ScanRange range, Progress progress = {});
+    /// @p definitions: the identify reads of device definitions, tried on every
+    /// Modbus device that is none of the built-in types (device_probe.hpp).
+    LineScanner(LineLink& link, ScanRange range, Progress progress = {},
+                std::vector<DefinitionIdentify> definitions = {});
 
     /// Runs the whole scan. Throws engine::SerialPortError when the port fails.
     [[nodiscard]] ScanResult run();
@@ -52,6 +55,7 @@ private:
     LineLink& link_;
     ScanRange range_;
     Progress progress_;
+    std::vector<DefinitionIdentify> definitions_;
 };
 
 }  // namespace fieldbridge::scan

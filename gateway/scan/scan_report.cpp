@@ -23,7 +23,8 @@ constexpr std::uint32_t assumed_wtec_stroke = 20000;
 }  // namespace
 
 std::string suggested_name(const FoundDevice& device) {
-    return std::string{engine::to_string(device.type)} + "-" + std::to_string(device.address);
+    const std::string type = device.definition.empty() ? std::string{engine::to_string(device.type)} : device.definition;
+    return type + "-" + std::to_string(device.address);
 }
 
 std::string config_snippet(const ScannedLine& line, const std::vector<FoundDevice>& devices) {
@@ -40,14 +41,14 @@ std::string config_snippet(const ScannedLine& line, const std::vector<FoundDevic
     for (const FoundDevice& d : devices) {
         out << "  - name: " << suggested_name(d) << "\n"
             << "    # " << one_line(d.detail) << "\n"
-            << "    type: " << engine::to_string(d.type) << "\n"
+            << "    type: " << (d.definition.empty() ? std::string{engine::to_string(d.type)} : d.definition) << "\n"
             << "    address: " << unsigned{d.address} << "\n"
             << "    unit_id: " << unsigned{d.address} << "\n";
         if (d.type == engine::DeviceType::wtec_ascii) {
             out << "    # stroke cannot be read over the bus: measure the encoder counts at 100 %\n"
                 << "    # (N's target at both ends) and correct this value.\n"
                 << "    stroke: " << assumed_wtec_stroke << "\n";
-        } else if (d.type == engine::DeviceType::modbus) {
+        } else if (d.type == engine::DeviceType::modbus && d.definition.empty()) {
             out << (d.holding_zero_readable ? "    # holding register 0x0000 answered; add the device's other registers\n"
                                             : "    # the register map is unknown (0x0000 answered with an exception):\n"
                                               "    # replace this block with the device's registers\n")

@@ -88,6 +88,30 @@ class ScanTest(simlib.SimTestCase):
         check, config = self.check_config(self.path("line2"), result.stdout)
         self.assertEqual(check.returncode, 0, "config:\n%s\nstderr:\n%s" % (config, check.stderr))
 
+    def test_a_definition_identify_read_names_a_generic_device(self):
+        shipped = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir,
+                                                os.pardir, "config", "devices"))
+        self.start("--definitions", shipped, "--bus", self.path("line4") + ":example-thermostat@7",
+                   "--control", self.path("sim.sock"))
+        # example-thermostat identifies by its firmware string starting with "TH".
+        self.assertEqual(self.control("device 7 set firmware TH-1.2"), "ok")
+        result = self.scan("--port", self.path("line4"), "--from", 6, "--to", 9, "--definitions", shipped)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        found = devices_of(result.stdout)
+        self.assertEqual(sorted(found), [7], result.stdout)
+        self.assertEqual(found[7]["type"], "example-thermostat")
+        self.assertEqual(found[7]["name"], "example-thermostat-7")
+        self.assertIn("address 7: example-thermostat, device definition example-thermostat: its identify read "
+                      "(holding 0x0020) reads the expected values", result.stderr)
+        body = "".join("    " + l + "\n" if l else "\n" for l in result.stdout.splitlines())
+        path = self.path("scan-definitions.yaml")
+        with open(path, "w") as f:
+            f.write("gateway:\n  id: scan-test\ndefinitions: [%s]\nlines:\n  - name: line-a\n    port: %s\n%s"
+                    % (shipped, self.path("line4"), body))
+        check = subprocess.run([FIELDBRIDGE, "--check-config", path], capture_output=True, text=True,
+                               timeout=SCAN_TIMEOUT)
+        self.assertEqual(check.returncode, 0, check.stderr)
+
     def test_every_ascii_station_answering_one_query_is_found(self):
         # Both gripper replies to `$` come back to back, often in one read.
         self.start("--bus", self.path("line3") + ":wtec-ascii@5,wtec-ascii@9,hiwin-xeg@12")

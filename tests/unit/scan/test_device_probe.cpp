@@ -109,6 +109,68 @@ TEST_CASE("a generic Modbus device whose first holding register reads a value") 
     CHECK(probe.result()->detail == "answers FC03 at 0x0000; not an XEG, WTEC-485 or EXCD203MB");
 }
 
+TEST_CASE("no built-in type: the definitions' identify reads in order; the first that matches names the device") {
+    core::IdentifyRead meter_read;
+    meter_read.table = core::RegisterTable::input;
+    meter_read.address = 0x0100;
+    meter_read.count = 2;
+    meter_read.expect = {0x4D31, 0x0002};
+    core::IdentifyRead thermostat_read;
+    thermostat_read.address = 0x0020;  // holding, one register, any value
+    const std::vector<DefinitionIdentify> definitions{{"acme-meter", meter_read}, {"acme-thermostat", thermostat_read}};
+    // Presence answered, then no XEG, WTEC or EXCD203MB: the definitions come next.
+    const auto past_built_in_types = [](ModbusProbe& probe) {
+        for (const auto& reply : std::vector<std::optional<Response>>{values({1}), std::nullopt, std::nullopt, std::nullopt}) {
+            (void)expect_read(probe);
+            probe.on_reply(reply);
+        }
+        REQUIRE_FALSE(probe.finished());
+    };
+
+    SUBCASE("the second matches: FC04 of the first, then FC03 of the second") {
+        ModbusProbe probe(9, definitions);
+        past_built_in_types(probe);
+        auto next = probe.next();
+        REQUIRE(next.has_value());
+        CHECK(std::get<ReadRegistersRequest>(*next) == ReadRegistersRequest{fc::read_input_registers, 0x0100, 2});
+        probe.on_reply(values({0x4D31, 0x0003}));  // not the expected values
+        next = probe.next();
+        REQUIRE(next.has_value());
+        CHECK(std::get<ReadRegistersRequest>(*next) == ReadRegistersRequest{fc::read_holding_registers, 0x0020, 1});
+        probe.on_reply(values({0x1234}));  // no expect: any answer
+        REQUIRE(probe.finished());
+        REQUIRE(probe.result().has_value());
+        CHECK(probe.result()->type == engine::DeviceType::modbus);
+        CHECK(probe.result()->definition == "acme-thermostat");
+        CHECK(probe.result()->detail == "device definition acme-thermostat: its identify read (holding 0x0020) is answered");
+    }
+    SUBCASE("the first matches its expected values") {
+        ModbusProbe probe(9, definitions);
+        past_built_in_types(probe);
+        probe.on_reply(values({0x4D31, 0x0002}));
+        REQUIRE(probe.result().has_value());
+        CHECK(probe.result()->definition == "acme-meter");
+        CHECK(probe.result()->detail ==
+              "device definition acme-meter: its identify read (input 0x0100-0x0101) reads the expected values");
+    }
+    SUBCASE("none matches (an exception, no reply): a generic device") {
+        ModbusProbe probe(9, definitions);
+        past_built_in_types(probe);
+        probe.on_reply(exception(ExceptionCode::illegal_data_address));
+        probe.on_reply(std::nullopt);
+        REQUIRE(probe.finished());
+        CHECK(probe.result()->definition.empty());
+        CHECK(probe.result()->detail ==
+              "answers FC03 at 0x0000; not an XEG, WTEC-485 or EXCD203MB, nor a device definition's identify read");
+    }
+    SUBCASE("a built-in type is found first; the definitions are not read") {
+        ModbusProbe probe(2, definitions);
+        run(probe, {exception(ExceptionCode::illegal_data_address), values({0x0A20})});
+        CHECK(probe.result()->type == engine::DeviceType::hiwin_xeg);
+        CHECK(probe.result()->definition.empty());
+    }
+}
+
 TEST_CASE("on_reply after the probe finished is a caller error") {
     ModbusProbe probe(1);
     probe.on_reply(std::nullopt);
