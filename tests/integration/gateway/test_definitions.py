@@ -113,7 +113,7 @@ class DefinitionDevice(gatewaylib.CellTestCase):
         client = self.client()
         self.assertEqual(self.read_input(client, 0x0000, 4, UNIT), float_registers(230.5) + [123456 & 0xFFFF, 123456 >> 16])
         # A register no point names: 0x02, without asking the device.
-        self.assert_exception(client.read_input_registers(0x0005, 1, slave=UNIT), 0x02)
+        self.assert_exception(client.read_input_registers(0x0005, count=1, slave=UNIT), 0x02)
         # Point checks on writes: 25.0 degC is in range, 40.0 is not (0x03); half of a
         # two-register point is refused (0x02); a read-only table cannot be written.
         self.assert_ok(client.write_register(0x0011, 250, slave=UNIT))
@@ -128,7 +128,7 @@ class DefinitionDevice(gatewaylib.CellTestCase):
         mark = self.sub.mark()
         self.command({"op": "write", "values": {"setpoint": 22.5, "mode": "cool", "relay": True}})
         self.assertEqual(self.read_holding(client, 0x0010, 2, UNIT), [2, 225])
-        self.assertEqual(self.assert_ok(client.read_coils(0x0003, 1, slave=UNIT)).bits[0], True)
+        self.assertEqual(self.assert_ok(client.read_coils(0x0003, count=1, slave=UNIT)).bits[0], True)
         self.wait_state(lambda s: s["fields"].get("mode") == "cool" and s["fields"].get("setpoint") == 22.5
                         and s["fields"].get("relay") is True, mark)
         refused = self.command({"op": "write", "values": {"mode": "off", "setpoint": 99}}, ok=False)
