@@ -99,14 +99,14 @@ check "both packages built: $(basename "$deb") $(basename "$sim_deb")" test -f "
 check "lintian: no error or warning" lintian --fail-on error,warning --display-info "$deb" "$sim_deb"
 check "dependencies computed by dpkg-shlibdeps (libmodbus, paho, yaml-cpp, libsystemd)" \
   contains "$(dpkg-deb -f "$deb" Depends)" 'libmodbus5.*libpaho-mqttpp3-1.*libsystemd0.*libyaml-cpp0'
-# Each release's own library packages: the names that differ between Debian 12 and 13.
+# Each release's own library packages: the names that differ between Debian 12 and 13;
+# and where its units go (deploy/build-deb).
 case "$version" in
-  *~deb12) release_libraries=('libyaml-cpp0\.7' 'libfmt9' 'libmicrohttpd12 ') ;;
-  *~deb13) release_libraries=('libyaml-cpp0\.8' 'libfmt10' 'libmicrohttpd12t64 ') ;;
-  *) release_libraries=() ;;
+  *~deb12) release_libraries=('libyaml-cpp0\.7' 'libfmt9' 'libmicrohttpd12 ') unit_dir=/lib/systemd/system ;;
+  *) release_libraries=('libyaml-cpp0\.8' 'libfmt10' 'libmicrohttpd12t64 ') unit_dir=/usr/lib/systemd/system ;;
 esac
 for library in "${release_libraries[@]}"; do
-  check "dependencies: ${library//\\/} of Debian ${version##*~deb}" contains "$(dpkg-deb -f "$deb" Depends)" "(^|, )$library"
+  check "dependencies: ${library//[\\ ]/} of Debian ${version##*~deb}" contains "$(dpkg-deb -f "$deb" Depends)" "(^|, )$library"
 done
 
 if [ "$arch" != "$native" ]; then
@@ -159,13 +159,13 @@ check "apt-get install ./fieldbridge_*.deb ./fieldbridge-sim_*.deb" \
 check "user fieldbridge: system user, no login shell" \
   contains "$(getent passwd fieldbridge)" '^fieldbridge:x:[0-9]{1,3}:[0-9]+:.*:(/usr/sbin/nologin|/sbin/nologin)$'
 check "user fieldbridge: groups fieldbridge and dialout" contains " $(id -nG fieldbridge) " ' fieldbridge .*dialout |.* dialout .*fieldbridge '
-for f in /usr/bin/fieldbridge /usr/bin/fieldbridge-sim /lib/systemd/system/fieldbridge.service \
+for f in /usr/bin/fieldbridge /usr/bin/fieldbridge-sim "$unit_dir/fieldbridge.service" \
          /usr/lib/sysusers.d/fieldbridge.conf /etc/fieldbridge/fieldbridge.yaml \
          /usr/share/man/man8/fieldbridge.8.gz /usr/share/man/man5/fieldbridge.yaml.5.gz \
          /usr/share/man/man1/fieldbridge-sim.1.gz /usr/share/doc/fieldbridge/copyright; do
   check "installed: $f" test -f "$f"
 done
-check "installed: /lib/systemd/system/fieldbridge.socket" test -f /lib/systemd/system/fieldbridge.socket
+check "installed: $unit_dir/fieldbridge.socket" contains "$(dpkg -L fieldbridge)" "^$unit_dir/fieldbridge\.socket\$"
 check "docs: the operations guide service.md in /usr/share/doc/fieldbridge" \
   contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/service\.md'
 check "conffile: /etc/fieldbridge/fieldbridge.yaml" \
@@ -190,7 +190,7 @@ check "the demo cell's Modbus TCP reads and writes through the installed daemon"
   /usr/bin/python3 "$here/tests/integration/gateway/test_modbus_devices.py" \
   --gateway /usr/bin/fieldbridge --sim /usr/bin/fieldbridge-sim
 check "systemd-analyze verify on the installed units: silent" \
-  silent systemd-analyze verify /lib/systemd/system/fieldbridge.*
+  silent systemd-analyze verify "$unit_dir"/fieldbridge.*
 check "the service is installed but not enabled" \
   test ! -e /etc/systemd/system/multi-user.target.wants/fieldbridge.service
 # What a running systemd would do, read from the maintainer scripts dh_installsystemd wrote.
@@ -214,7 +214,7 @@ check "after remove: fieldbridge is in state config-files" \
   contains "$(dpkg-query -W -f='${Status}' fieldbridge)" 'deinstall ok config-files'
 check "apt-get purge fieldbridge" as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq fieldbridge
 check "after purge: /etc/fieldbridge is gone" test ! -e /etc/fieldbridge
-check "after purge: no unit left" test ! -e /lib/systemd/system/fieldbridge.service
+check "after purge: no unit left" test ! -e "$unit_dir/fieldbridge.service"
 
 echo "test-package: $((SECONDS - started)) s in all"
 echo "package: $passed passed, $failed failed"
