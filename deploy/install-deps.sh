@@ -2,21 +2,34 @@
 # Installs every build, runtime and test dependency of fieldbridge from Debian 12
 # packages. Idempotent: packages already present are left alone, and apt is only
 # asked when something is missing. Needs root (or sudo) when it has to install.
-# Usage: deploy/install-deps.sh [--arch arm64|armhf]...
+# Usage: deploy/install-deps.sh [--arch arm64|armhf]... [--dist trixie]
 #   --arch ARCH  also what a cross build for the Debian architecture ARCH needs
 #                (docs/build.md, "Cross builds"): the cross compiler, qemu-user, and a
 #                target root of the libraries below made by deploy/cross/make-sysroot.
+#   --dist DIST  the build root of the Debian release DIST (trixie) instead of this
+#                machine: the packages below, from that release, installed into
+#                /var/cache/fieldbridge/root/DIST-amd64 by deploy/dist/make-root
+#                (docs/build.md, "Debian 13"); on this machine only mmdebstrap.
+#                --dist bookworm is this machine (Debian 12): as without --dist.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 cross_arches=()
+dist=bookworm
 while [ $# -gt 0 ]; do
   case "$1" in
     --arch) [ $# -ge 2 ] || { echo "install-deps: --arch needs arm64 or armhf" >&2; exit 2; }
             cross_arches+=("$2"); shift 2 ;;
-    *) echo "install-deps: unknown argument '$1' (usage: install-deps.sh [--arch arm64|armhf]...)" >&2; exit 2 ;;
+    --dist) [ $# -ge 2 ] || { echo "install-deps: --dist needs bookworm or trixie" >&2; exit 2; }
+            dist="$2"; shift 2 ;;
+    *) echo "install-deps: unknown argument '$1' (usage: install-deps.sh [--arch arm64|armhf]... [--dist bookworm|trixie])" >&2; exit 2 ;;
   esac
 done
+case "$dist" in
+  bookworm) ;;
+  trixie) [ ${#cross_arches[@]} -eq 0 ] || { echo "install-deps: --dist trixie is amd64 only (no --arch)" >&2; exit 2; } ;;
+  *) echo "install-deps: no build root for Debian release '$dist' (bookworm or trixie)" >&2; exit 2 ;;
+esac
 
 # The libraries the build links or includes (docs/dependencies.md says why each one is
 # here); a cross build gets the same set for its target in its own root.
@@ -38,6 +51,17 @@ packages=(
   # systemd for systemd-analyze and systemd-sysusers, man-db for man --warnings
   debhelper dpkg-dev lintian man-db systemd
 )
+root_packages=()
+if [ "$dist" != bookworm ]; then
+  # The build root's packages: the list above from that release, without the fuzz
+  # build's clang (the campaign runs on Debian 12 only), with ccache (the root's builds
+  # use the cache of deploy/dist/in-root) and strace (docs/performance.md).
+  for p in "${packages[@]}"; do
+    case "$p" in clang|libclang-rt-*) ;; *) root_packages+=("$p") ;; esac
+  done
+  root_packages+=(ccache strace)
+  packages=(mmdebstrap)
+fi
 for arch in "${cross_arches[@]}"; do
   case "$arch" in
     arm64|armhf) ;;
@@ -60,6 +84,9 @@ make_sysroots() {
   for arch in "${cross_arches[@]}"; do
     "$here/deploy/cross/make-sysroot" "$arch" "${libraries[@]}"
   done
+  if [ ${#root_packages[@]} -gt 0 ]; then
+    "$here/deploy/dist/make-root" "$dist" amd64 "${root_packages[@]}"
+  fi
 }
 
 if [ ${#missing[@]} -eq 0 ]; then

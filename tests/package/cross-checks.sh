@@ -43,7 +43,7 @@ for binary in fieldbridge fieldbridge-sim; do
 done
 
 check "fieldbridge --version under $qemu" \
-  contains "$("${emulator[@]}" "$unpacked/$arch/usr/bin/fieldbridge" --version 2>&1)" "^fieldbridge $version\$"
+  contains "$("${emulator[@]}" "$unpacked/$arch/usr/bin/fieldbridge" --version 2>&1)" "^fieldbridge $upstream_version\$"
 check "fieldbridge --check-config on the packaged /etc/fieldbridge/fieldbridge.yaml under $qemu: exit 0" \
   "${emulator[@]}" "$unpacked/$arch/usr/bin/fieldbridge" --check-config "$unpacked/$arch/etc/fieldbridge/fieldbridge.yaml"
 check "fieldbridge-sim --help under $qemu" "${emulator[@]}" "$unpacked/$arch/usr/bin/fieldbridge-sim" --help

@@ -23,7 +23,14 @@
 # Modbus TCP reads and writes through the packaged daemon against this machine's
 # simulator (tests/integration/gateway/test_modbus_devices.py).
 #
-# Usage: tests/package/test-package.sh [--arch ARCH]
+# With --dist trixie, the Debian 13 amd64 packages (deploy/build-deb --dist trixie, built
+# in the Debian 13 build root): every check above run inside that root (deploy/dist/
+# in-root), which has Debian 13's apt, systemd, lintian and test tools, then the
+# packages installed by apt into a clean, minimal Debian 13 root of their own (a fresh
+# copy each run; tests/package/clean-root-checks.sh): apt resolves their Depends from
+# Debian 13 alone, and the packaged fieldbridge checks its packaged configuration there.
+#
+# Usage: tests/package/test-package.sh [--arch ARCH | --dist DIST]
 #   FIELDBRIDGE_DEB_DIR        where the packages are built (default build-deb/)
 #   FIELDBRIDGE_DEB_PREBUILT=1 test the packages already in that directory, no build
 set -euo pipefail
@@ -31,21 +38,27 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 out="${FIELDBRIDGE_DEB_DIR:-$here/build-deb}"
 export FIELDBRIDGE_DEB_DIR="$out"
 native="$(dpkg --print-architecture)"
-arch="$native"
-if [ "${1:-}" = --arch ]; then
-  [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
-  arch="$2"
-fi
+arch="$native" dist=bookworm
+case "${1:-}" in
+  --arch) [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
+          arch="$2" ;;
+  --dist) [ $# -ge 2 ] || { echo "test-package: --dist needs a Debian release (bookworm or trixie)" >&2; exit 2; }
+          dist="$2" ;;
+esac
+build_args=(--arch "$arch") build_name="$arch"
+if [ "$dist" != bookworm ]; then build_args=(--dist "$dist") build_name="$dist-$arch"; fi
 
 started=$SECONDS
 if [ "${FIELDBRIDGE_DEB_PREBUILT:-0}" != 1 ]; then
   mkdir -p "$out"
   build_started=$SECONDS
-  log="$out/build-deb-$arch.log"
-  "$here/deploy/build-deb" --arch "$arch" > "$log" 2>&1 || { tail -50 "$log" >&2; echo "test-package: deploy/build-deb --arch $arch failed (log: $log)" >&2; exit 1; }
-  echo "test-package: deploy/build-deb --arch $arch took $((SECONDS - build_started)) s (log: $log)"
+  log="$out/build-deb-$build_name.log"
+  "$here/deploy/build-deb" "${build_args[@]}" > "$log" 2>&1 || { tail -50 "$log" >&2; echo "test-package: deploy/build-deb ${build_args[*]} failed (log: $log)" >&2; exit 1; }
+  echo "test-package: deploy/build-deb ${build_args[*]} took $((SECONDS - build_started)) s (log: $log)"
 fi
-version="$(sed -n 's/^project(fieldbridge VERSION \([0-9][0-9.]*\).*/\1/p' "$here/CMakeLists.txt")"
+# 0.2.0~deb12 (deploy/package-version); the programs say 0.2.0.
+version="$("$here/deploy/package-version")"
+upstream_version="${version%%~*}"
 deb="$out/fieldbridge_${version}_${arch}.deb"
 sim_deb="$out/fieldbridge-sim_${version}_${arch}.deb"
 
@@ -69,10 +82,32 @@ contains() {  # contains TEXT PATTERN: grep -E PATTERN in TEXT, TEXT shown when 
 }
 lacks() { ! grep -Eq -- "$2" <<<"$1" || { printf '/%s/ found in:\n%s\n' "$2" "$1"; return 1; }; }
 
+if [ "$dist" != bookworm ] && [ -z "${FIELDBRIDGE_IN_ROOT:-}" ]; then
+  # The checks below inside the release's build root, then the clean root's.
+  FIELDBRIDGE_DEB_PREBUILT=1 "$here/deploy/dist/in-root" "$dist" "$here/tests/package/test-package.sh"
+  version="$("$here/deploy/dist/in-root" "$dist" "$here/deploy/package-version")"
+  deb="$out/fieldbridge_${version}_${arch}.deb"
+  sim_deb="$out/fieldbridge-sim_${version}_${arch}.deb"
+  upstream_version="${version%%~*}"
+  . "$here/tests/package/clean-root-checks.sh"
+  echo "test-package: $((SECONDS - started)) s in all"
+  echo "package ($dist $arch, clean root): $passed passed, $failed failed"
+  [ "$failed" -eq 0 ]
+  exit
+fi
 check "both packages built: $(basename "$deb") $(basename "$sim_deb")" test -f "$deb" -a -f "$sim_deb"
 check "lintian: no error or warning" lintian --fail-on error,warning --display-info "$deb" "$sim_deb"
 check "dependencies computed by dpkg-shlibdeps (libmodbus, paho, yaml-cpp, libsystemd)" \
   contains "$(dpkg-deb -f "$deb" Depends)" 'libmodbus5.*libpaho-mqttpp3-1.*libsystemd0.*libyaml-cpp0'
+# Each release's own library packages: the names that differ between Debian 12 and 13;
+# and where its units go (deploy/build-deb).
+case "$version" in
+  *~deb12) release_libraries=('libyaml-cpp0\.7' 'libfmt9' 'libmicrohttpd12 ') unit_dir=/lib/systemd/system ;;
+  *) release_libraries=('libyaml-cpp0\.8' 'libfmt10' 'libmicrohttpd12t64 ') unit_dir=/usr/lib/systemd/system ;;
+esac
+for library in "${release_libraries[@]}"; do
+  check "dependencies: ${library//[\\ ]/} of Debian ${version##*~deb}" contains "$(dpkg-deb -f "$deb" Depends)" "(^|, )$library"
+done
 
 if [ "$arch" != "$native" ]; then
   . "$here/tests/package/cross-checks.sh"
@@ -124,19 +159,19 @@ check "apt-get install ./fieldbridge_*.deb ./fieldbridge-sim_*.deb" \
 check "user fieldbridge: system user, no login shell" \
   contains "$(getent passwd fieldbridge)" '^fieldbridge:x:[0-9]{1,3}:[0-9]+:.*:(/usr/sbin/nologin|/sbin/nologin)$'
 check "user fieldbridge: groups fieldbridge and dialout" contains " $(id -nG fieldbridge) " ' fieldbridge .*dialout |.* dialout .*fieldbridge '
-for f in /usr/bin/fieldbridge /usr/bin/fieldbridge-sim /lib/systemd/system/fieldbridge.service \
+for f in /usr/bin/fieldbridge /usr/bin/fieldbridge-sim "$unit_dir/fieldbridge.service" \
          /usr/lib/sysusers.d/fieldbridge.conf /etc/fieldbridge/fieldbridge.yaml \
          /usr/share/man/man8/fieldbridge.8.gz /usr/share/man/man5/fieldbridge.yaml.5.gz \
          /usr/share/man/man1/fieldbridge-sim.1.gz /usr/share/doc/fieldbridge/copyright; do
   check "installed: $f" test -f "$f"
 done
-check "installed: /lib/systemd/system/fieldbridge.socket" test -f /lib/systemd/system/fieldbridge.socket
+check "installed: $unit_dir/fieldbridge.socket" contains "$(dpkg -L fieldbridge)" "^$unit_dir/fieldbridge\.socket\$"
 check "docs: the operations guide service.md in /usr/share/doc/fieldbridge" \
   contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/service\.md'
 check "conffile: /etc/fieldbridge/fieldbridge.yaml" \
   contains "$(dpkg-query -W -f='${Conffiles}' fieldbridge)" '^ /etc/fieldbridge/fieldbridge\.yaml [0-9a-f]{32}$'
 check "conffile is the commented example" cmp /etc/fieldbridge/fieldbridge.yaml "$here/config/fieldbridge.example.yaml"
-check "fieldbridge --version" contains "$(fieldbridge --version)" "^fieldbridge $version\$"
+check "fieldbridge --version" contains "$(fieldbridge --version)" "^fieldbridge $upstream_version\$"
 check "fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml (as user fieldbridge): exit 0" \
   as_root runuser -u fieldbridge -- /usr/bin/fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml
 check "fieldbridge-sim --help" /usr/bin/fieldbridge-sim --help
@@ -160,8 +195,15 @@ check "hitless reload on the installed binaries: no failed request, no reopened 
   env FIELDBRIDGE_RELEASE_BUILD=1 PYTHONPATH="$here/tests/integration/gateway:$here/tests/integration/sim:$here/tests/integration" \
   /usr/bin/python3 "$here/tests/integration/gateway/test_hitless_reload.py" \
   --gateway /usr/bin/fieldbridge --sim /usr/bin/fieldbridge-sim
+# The demo cell (tests/integration/gateway/gatewaylib.py: two lines, four devices) read
+# and written over Modbus TCP through the installed daemon and simulator.
+check "the demo cell's Modbus TCP reads and writes through the installed daemon" \
+  env PYTHONDONTWRITEBYTECODE=1 \
+  PYTHONPATH="$here/tests/integration/gateway:$here/tests/integration/sim:$here/tests/integration" \
+  /usr/bin/python3 "$here/tests/integration/gateway/test_modbus_devices.py" \
+  --gateway /usr/bin/fieldbridge --sim /usr/bin/fieldbridge-sim
 check "systemd-analyze verify on the installed units: silent" \
-  silent systemd-analyze verify /lib/systemd/system/fieldbridge.*
+  silent systemd-analyze verify "$unit_dir"/fieldbridge.*
 check "the service is installed but not enabled" \
   test ! -e /etc/systemd/system/multi-user.target.wants/fieldbridge.service
 # What a running systemd would do, read from the maintainer scripts dh_installsystemd wrote.
@@ -185,7 +227,7 @@ check "after remove: fieldbridge is in state config-files" \
   contains "$(dpkg-query -W -f='${Status}' fieldbridge)" 'deinstall ok config-files'
 check "apt-get purge fieldbridge" as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq fieldbridge
 check "after purge: /etc/fieldbridge is gone" test ! -e /etc/fieldbridge
-check "after purge: no unit left" test ! -e /lib/systemd/system/fieldbridge.service
+check "after purge: no unit left" test ! -e "$unit_dir/fieldbridge.service"
 
 echo "test-package: $((SECONDS - started)) s in all"
 echo "package: $passed passed, $failed failed"

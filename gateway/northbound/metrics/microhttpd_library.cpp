@@ -26,8 +26,9 @@ void resolve(void* handle, const char* name, Function& function, const std::stri
     void* symbol = ::dlsym(handle, name);
     if (symbol == nullptr) {
         throw MetricsHttpError(fmt::format(
-            "{}: {} has no {} ({}); it is not the libmicrohttpd this build expects: install Debian 12's "
-            "libmicrohttpd12 (`apt install libmicrohttpd12`), or remove the metrics_http section",
+            "{}: {} has no {} ({}); it is not the libmicrohttpd this build expects: install Debian's "
+            "(`apt install libmicrohttpd12` on Debian 12, libmicrohttpd12t64 on Debian 13), or remove the "
+            "metrics_http section",
             context, library, name, last_dl_error("symbol not found")));
     }
     function = reinterpret_cast<Function>(symbol);
@@ -44,8 +45,9 @@ const MicrohttpdApi& load_microhttpd(const std::string& library, const std::stri
     void* handle = ::dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (handle == nullptr) {
         throw MetricsHttpError(fmt::format(
-            "{}: cannot load the HTTP library {} ({}); the fieldbridge package depends on libmicrohttpd12: "
-            "reinstall it (`apt install libmicrohttpd12`), or remove the metrics_http section to serve no metrics",
+            "{}: cannot load the HTTP library {} ({}); the fieldbridge package depends on it: reinstall it "
+            "(`apt install libmicrohttpd12` on Debian 12, libmicrohttpd12t64 on Debian 13), or remove the "
+            "metrics_http section to serve no metrics",
             context, library, last_dl_error("dlopen failed")));
     }
     MicrohttpdApi api;

@@ -44,7 +44,10 @@ std::string iso8601_utc(WallTime time) {
     const auto t = static_cast<std::time_t>(seconds);
     std::tm utc{};
     gmtime_r(&t, &utc);
-    std::array<char, 40> text{};
+    // Room for every int the fields could hold (7 of 11 characters and the separators),
+    // not only for real dates: GCC 14 cannot bound the calendar fields and warns
+    // (-Wformat-truncation) for a buffer that fits "YYYY-MM-DDThh:mm:ss.mmmZ" alone.
+    std::array<char, 96> text{};
     std::snprintf(text.data(), text.size(), "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", utc.tm_year + 1900, utc.tm_mon + 1,
                   utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, static_cast<int>(millis));
     return text.data();

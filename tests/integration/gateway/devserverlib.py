@@ -97,8 +97,21 @@ class DeviceServer:
                     elif item == self.pty:
                         self._from_line()
 
+    def _client_closed(self):
+        """The client's end of file is already here (read without taking it)."""
+        try:
+            return self.client.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+        except BlockingIOError:
+            return False
+        except OSError:
+            return True
+
     def _accept(self):
         conn, _ = self.listener.accept()
+        if self.client is not None and self._client_closed():
+            # The gateway closed and connected again within one select() round: the
+            # close came first (its end of file is queued), so this is no second client.
+            self._drop_client()
         if self.client is not None:
             # One client at a time, as most device servers in TCP server mode.
             conn.close()

@@ -563,10 +563,10 @@ class CellTestCase(unittest.TestCase):
         self.assertEqual(getattr(reply, "exception_code", None), code, reply)
 
     def read_holding(self, client, address, count, unit):
-        return self.assert_ok(client.read_holding_registers(address, count, slave=unit)).registers
+        return self.assert_ok(client.read_holding_registers(address, count=count, slave=unit)).registers
 
     def read_input(self, client, address, count, unit):
-        return self.assert_ok(client.read_input_registers(address, count, slave=unit)).registers
+        return self.assert_ok(client.read_input_registers(address, count=count, slave=unit)).registers
 
     def wait_value(self, read, expected, timeout, what):
         """Polls read() until it returns expected (bounded); returns the last value."""

@@ -87,7 +87,7 @@ class DeviceServerCell(gatewaylib.CellTestCase):
                                   meter_timeout=meter_timeout, meter_extra=self.meter_extra))
 
     def meter(self, register, client=None):
-        reply = (client or self.client_).read_holding_registers(register, 1, slave=METER)
+        reply = (client or self.client_).read_holding_registers(register, count=1, slave=METER)
         return None if reply.isError() else reply.registers[0]
 
     def set_meter(self, register, value):
@@ -190,7 +190,7 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         self.set_meter(0, 111)
         self.set_meter(10, 222)
         self.server_m.set_mode(mode)
-        self.assert_exception(self.client_.read_holding_registers(0, 1, slave=METER), GATEWAY_TIMEOUT)
+        self.assert_exception(self.client_.read_holding_registers(0, count=1, slave=METER), GATEWAY_TIMEOUT)
         self.assertEqual(self.meter(10), 222)
         self.assertEqual(self.meter(0), 111)
 
@@ -208,7 +208,7 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         self.start_servers_and_gateway()
         self.set_meter(0, 77)
         self.server_m.set_mode("cut")
-        reply = self.client_.read_holding_registers(0, 1, slave=METER)
+        reply = self.client_.read_holding_registers(0, count=1, slave=METER)
         self.assertTrue(reply.isError(), reply)
         self.assertIn(reply.exception_code, (GATEWAY_TIMEOUT, PATH_DOWN))
         self.wait_value(lambda: self.meter(0), 77, 5, "the meter after the reconnect")
@@ -221,9 +221,9 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         self.start_servers_and_gateway()
         self.set_meter(0, 55)
         self.server_m.refuse()
-        self.wait_value(lambda: self.client_.read_holding_registers(0, 1, slave=METER).isError(), True, 5,
+        self.wait_value(lambda: self.client_.read_holding_registers(0, count=1, slave=METER).isError(), True, 5,
                         "an exception while the device server is gone")
-        reply = self.client_.read_holding_registers(0, 1, slave=METER)
+        reply = self.client_.read_holding_registers(0, count=1, slave=METER)
         self.assert_exception(reply, PATH_DOWN)
         simlib.wait_until(lambda: "Connection refused" in self.gateway.text(), 5)
         self.assertIn("Connection refused", self.gateway.text())

@@ -50,7 +50,7 @@ class Reader(threading.Thread):
         deadline = time.monotonic() + 60  # bounded whatever happens
         while not self.stop.is_set() and time.monotonic() < deadline:
             try:
-                reply = self.client.read_input_registers(XEG_POSITION, 2, slave=READ_UNIT)
+                reply = self.client.read_input_registers(XEG_POSITION, count=2, slave=READ_UNIT)
                 ok = not reply.isError()
                 if not ok:
                     self.failures.append(repr(reply))

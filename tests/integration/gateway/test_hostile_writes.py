@@ -138,14 +138,14 @@ class HostileWrites(Cell):
             frames = self.device_frames("line-a", 3)
             end = time.monotonic() + seconds
             while time.monotonic() < end:
-                reply = client.read_holding_registers(0x0014, 2, slave=EXCD)
+                reply = client.read_holding_registers(0x0014, count=2, slave=EXCD)
                 if reply.isError():
                     failed.append(getattr(reply, "exception_code", reply))
                 else:
                     ok += 1
             return ok, failed, self.device_frames("line-a", 3) - frames
 
-        self.assertTrue(simlib.wait_until(lambda: not client.read_holding_registers(0x0014, 2, slave=EXCD).isError(),
+        self.assertTrue(simlib.wait_until(lambda: not client.read_holding_registers(0x0014, count=2, slave=EXCD).isError(),
                                           TIMEOUT, interval=0.05))
         baseline, failed, baseline_frames = read_rate(2.0)
         self.assertEqual(failed, [])
@@ -194,7 +194,7 @@ class HostileWrites(Cell):
         # within seconds of the flood's end (the budget's debt has a floor).
         self.start_cell()
         client = self.client()
-        self.assertTrue(simlib.wait_until(lambda: not client.read_input_registers(0x0300, 2, slave=XEG).isError(),
+        self.assertTrue(simlib.wait_until(lambda: not client.read_input_registers(0x0300, count=2, slave=XEG).isError(),
                                           TIMEOUT, interval=0.05))
 
         def xeg_rate(seconds):
@@ -202,7 +202,7 @@ class HostileWrites(Cell):
             frames = self.device_frames("line-a", 2)
             end = time.monotonic() + seconds
             while time.monotonic() < end:
-                reply = client.read_input_registers(0x0300, 2, slave=XEG)
+                reply = client.read_input_registers(0x0300, count=2, slave=XEG)
                 if reply.isError():
                     failed.append(getattr(reply, "exception_code", reply))
                 time.sleep(0.01)
@@ -280,7 +280,7 @@ class HostileWrites(Cell):
         self.start_cell()
         client = self.client()
         sock = self.raw()
-        self.assertTrue(simlib.wait_until(lambda: not client.read_holding_registers(0x0026, 1, slave=EXCD).isError(),
+        self.assertTrue(simlib.wait_until(lambda: not client.read_holding_registers(0x0026, count=1, slave=EXCD).isError(),
                                           TIMEOUT, interval=0.05))
         old = self.read_holding(client, 0x0026, 1, EXCD)[0]
         for transaction, value in enumerate(((old + 7) % 0x64, old), start=1):

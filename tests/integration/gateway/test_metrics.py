@@ -76,7 +76,7 @@ class Metrics(gatewaylib.CellTestCase):
         client = self.client()
         for _ in range(5):
             self.assertEqual(self.read_holding(client, XEG_MODEL, 1, XEG), [0x0A20])
-        refused = client.read_holding_registers(0, 1, slave=NO_SUCH_UNIT)
+        refused = client.read_holding_registers(0, count=1, slave=NO_SUCH_UNIT)
         self.assertTrue(refused.isError(), refused)
         self.wait_sample("fieldbridge_mqtt_connected", lambda v: v == 1, "MQTT never shown connected")
         self.wait_sample("fieldbridge_upstream_up", lambda v: v == 1, "the R6 link never shown up", upstream="r6")

@@ -31,12 +31,12 @@ class ExceptionCodes(gatewaylib.CellTestCase):
                    " action: deny}\n"))
         client = self.client()
         # 0x01: FC01 is not an XEG function code; an access rule denies.
-        self.assert_exception(client.read_coils(0, 1, slave=XEG), 0x01)
+        self.assert_exception(client.read_coils(0, count=1, slave=XEG), 0x01)
         self.assert_exception(client.write_register(0x0300, 1, slave=WTEC_RTU), 0x01)
         self.assertEqual(self.read_holding(client, 0x0300, 1, WTEC_RTU), [1])  # reads still allowed
         # 0x02: outside the map (a hole; the XEG's input register 0x0302).
-        self.assert_exception(client.read_holding_registers(0x0700, 1, slave=XEG), 0x02)
-        self.assert_exception(client.read_input_registers(0x0302, 1, slave=XEG), 0x02)
+        self.assert_exception(client.read_holding_registers(0x0700, count=1, slave=XEG), 0x02)
+        self.assert_exception(client.read_input_registers(0x0302, count=1, slave=XEG), 0x02)
         # 0x03: value out of range (reset takes 0-1); quantity 0 and 126 (raw frames).
         self.assert_exception(client.write_register(0x0610, 2, slave=XEG), 0x03)
         sock = self.raw()
@@ -47,20 +47,20 @@ class ExceptionCodes(gatewaylib.CellTestCase):
             answers[transaction] = pdu
         self.assertEqual(answers, {1: b"\x84\x03", 2: b"\x84\x03"})
         # 0x0A: no route; a line whose port is missing.
-        self.assert_exception(client.read_holding_registers(0x0600, 1, slave=99), 0x0A)
-        self.assert_exception(client.read_input_registers(0x0300, 1, slave=9), 0x0A)
+        self.assert_exception(client.read_holding_registers(0x0600, count=1, slave=99), 0x0A)
+        self.assert_exception(client.read_input_registers(0x0300, count=1, slave=9), 0x0A)
         # 0x0B: a configured address nobody answers.
-        self.assert_exception(client.read_input_registers(0x0300, 1, slave=7), 0x0B)
+        self.assert_exception(client.read_input_registers(0x0300, count=1, slave=7), 0x0B)
         # 0x0B: a device whose replies the simulator drops (after its image went stale).
         self.control("fault line-b@1:drop")
 
         def no_answer():
-            reply = client.read_holding_registers(0x0204, 1, slave=WTEC_RTU)
+            reply = client.read_holding_registers(0x0204, count=1, slave=WTEC_RTU)
             return reply.isError() and reply.exception_code == 0x0B
         self.assertTrue(simlib.wait_until(no_answer, TIMEOUT, interval=0.1), "no 0x0B with drop fault")
         self.control("fault clear")
         self.assertTrue(simlib.wait_until(
-            lambda: not client.read_holding_registers(0x0204, 1, slave=WTEC_RTU).isError(), TIMEOUT,
+            lambda: not client.read_holding_registers(0x0204, count=1, slave=WTEC_RTU).isError(), TIMEOUT,
             interval=0.2), "the WTEC RTU gripper never came back after the fault was cleared")
         # A device exception passed through: the XEG refuses a move before a reset (0x04).
         self.assert_exception(client.write_registers(0x0630, [1000, 5000, 1], slave=XEG), 0x04)
@@ -74,7 +74,7 @@ class ExceptionCodes(gatewaylib.CellTestCase):
         # (the queue holds every class): wait until one read gets through.
         client = self.client()
         self.assertTrue(simlib.wait_until(
-            lambda: not client.read_holding_registers(0x0204, 1, slave=8).isError(), TIMEOUT, interval=0.05))
+            lambda: not client.read_holding_registers(0x0204, count=1, slave=8).isError(), TIMEOUT, interval=0.05))
         socks = [self.raw() for _ in range(4)]
         for s_index, sock in enumerate(socks):
             sock.sendall(b"".join(mbap(s_index * 100 + i, 8, read_pdu(0x0204, 1)) for i in range(16)))
@@ -226,7 +226,7 @@ class R6PassThrough(gatewaylib.CellTestCase):
                     if client.write_registers(0x0883, [0, counter], slave=R6).isError():
                         failures.append("select %d refused" % counter)
                         return
-                    reply = client.read_holding_registers(0x0883, 6, slave=R6)
+                    reply = client.read_holding_registers(0x0883, count=6, slave=R6)
                     if reply.isError():
                         failures.append("read of counter %d: %r" % (counter, reply))
                         return

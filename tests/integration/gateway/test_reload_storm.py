@@ -32,7 +32,7 @@ class Reader(threading.Thread):
         deadline = time.monotonic() + 120  # bounded whatever happens
         while not self.stop.is_set() and time.monotonic() < deadline:
             try:
-                reply = self.client.read_input_registers(XEG_POSITION, 2, slave=READ_UNIT)
+                reply = self.client.read_input_registers(XEG_POSITION, count=2, slave=READ_UNIT)
                 if reply.isError():
                     self.outcomes["exception 0x%02X" % getattr(reply, "exception_code", 0)] += 1
                 else:

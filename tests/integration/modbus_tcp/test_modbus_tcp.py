@@ -96,22 +96,22 @@ class ModbusTcpServerTest(unittest.TestCase):
 
     def test_pymodbus_reads_writes_and_exceptions(self):
         client = self.pymodbus_client()
-        reply = client.read_holding_registers(0x0300, 2, slave=1)
+        reply = client.read_holding_registers(0x0300, count=2, slave=1)
         self.assertFalse(reply.isError(), reply)
         self.assertEqual(reply.registers, [0x0300, 0x0301])
         reply = client.write_register(10, 1234, slave=1)
         self.assertFalse(reply.isError(), reply)
-        self.assertEqual(client.read_holding_registers(10, 1, slave=1).registers, [1234])
+        self.assertEqual(client.read_holding_registers(10, count=1, slave=1).registers, [1234])
         reply = client.write_registers(20, [7, 8, 9], slave=2)
         self.assertFalse(reply.isError(), reply)
-        self.assertEqual(client.read_input_registers(20, 3, slave=2).registers, [7, 8, 9])
+        self.assertEqual(client.read_input_registers(20, count=3, slave=2).registers, [7, 8, 9])
         # Access rule: unit 2 registers 100-199 are not writable -> 0x01.
         reply = client.write_register(150, 1, slave=2)
         self.assertTrue(reply.isError())
         self.assertEqual(reply.exception_code, 0x01)
-        self.assertEqual(client.read_holding_registers(150, 1, slave=2).registers, [150])  # unchanged
+        self.assertEqual(client.read_holding_registers(150, count=1, slave=2).registers, [150])  # unchanged
         # No route -> 0x0A.
-        reply = client.read_holding_registers(0, 1, slave=9)
+        reply = client.read_holding_registers(0, count=1, slave=9)
         self.assertTrue(reply.isError())
         self.assertEqual(reply.exception_code, 0x0A)
 

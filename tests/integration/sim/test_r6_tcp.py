@@ -144,13 +144,15 @@ class R6Tcp(simlib.SimTestCase):
         return client
 
     def regs(self, client, address, count, unit=1):
-        rr = client.read_holding_registers(address, count, slave=unit)
+        rr = client.read_holding_registers(address, count=count, slave=unit)
         self.assertFalse(rr.isError(), "read 0x%04X x%d: %s" % (address, count, rr))
         return rr.registers
 
     def decoder(self, registers):
         # The R6 sends 32- and 64-bit values high word first, big-endian bytes.
-        return BinaryPayloadDecoder.fromRegisters(registers, byteorder=Endian.Big, wordorder=Endian.Big)
+        # Endian.Big in pymodbus 3.0 (Debian 12), Endian.BIG in 3.8 (Debian 13).
+        big = Endian.BIG if hasattr(Endian, "BIG") else Endian.Big
+        return BinaryPayloadDecoder.fromRegisters(registers, byteorder=big, wordorder=big)
 
     def test_pymodbus_reads_the_running_robot(self):
         port = self.start_r6()
