@@ -10,7 +10,7 @@
 minimal_name="$dist-$arch-minimal"
 "$here/deploy/dist/make-root" --name "$minimal_name" "$dist" "$arch"
 minimal="$("$here/deploy/dist/make-root" --name "$minimal_name" --path "$dist" "$arch")"
-clean="$(mktemp -d /var/tmp/fieldbridge-clean-root.XXXXXX)"
+clean="$(mktemp -d -p /var/tmp)"
 trap 'rm -rf "$clean"' EXIT
 cp -a "$minimal/." "$clean/"
 in_clean() { "$here/deploy/dist/in-root" --root "$clean" "$dist" "$@"; }

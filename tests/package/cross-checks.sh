@@ -21,7 +21,7 @@ if [ ! -f "$native_deb" ] || [ ! -f "$native_sim_deb" ]; then
   "$here/deploy/build-deb" > "$native_log" 2>&1 || { tail -50 "$native_log" >&2; echo "test-package: deploy/build-deb failed (log: $native_log)" >&2; exit 1; }
 fi
 
-unpacked="$(mktemp -d "${TMPDIR:-/tmp}/fieldbridge-cross-package.XXXXXX")"
+unpacked="$(mktemp -d)"
 trap 'rm -rf "$unpacked"' EXIT
 dpkg-deb -x "$deb" "$unpacked/$arch"
 dpkg-deb -x "$sim_deb" "$unpacked/$arch"

@@ -143,6 +143,7 @@ group_existed=0; getent group fieldbridge >/dev/null && group_existed=1
 
 cleanup() {
   local rc=$?
+  rm -f "${definition_config:-}"
   for p in fieldbridge-sim fieldbridge; do
     if installed "$p"; then as_root env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "$p" >/dev/null || rc=1; fi
   done
@@ -181,7 +182,7 @@ check "docs: the definition guide devices.md in /usr/share/doc/fieldbridge" \
   contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/devices\.md'
 # A device of a shipped definition, with no definitions: key: found in the default
 # directories (docs/devices.md).
-definition_config="$(mktemp /tmp/fb-package-definition-XXXXXX.yaml)"
+definition_config="$(mktemp -p /tmp --suffix=.yaml)"
 printf '%s\n' 'gateway: {id: pkg}' 'lines:' '  - name: a' '    port: /dev/ttyS0' '    devices:' \
   '      - {name: room, type: example-thermostat, address: 7, unit_id: 1}' > "$definition_config"
 chmod 0644 "$definition_config"
