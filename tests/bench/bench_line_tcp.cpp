@@ -13,9 +13,7 @@
 // must be on the PATH (deploy/install-deps.sh installs it). Not a test: it prints
 // figures and asserts nothing.
 
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -30,6 +28,7 @@
 #include <fmt/format.h>
 
 #include "engine_harness.hpp"
+#include "free_port.hpp"
 #include "line_limit.hpp"
 #include "load_shape.hpp"
 #include "read_load.hpp"
@@ -47,19 +46,6 @@ using std::chrono::seconds;
 
 constexpr unsigned outstanding_reads = 16;
 constexpr std::uint16_t status_address = 0x0300;
-
-/// A loopback port nobody listens on now (socat binds it right after).
-std::uint16_t free_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof address;
-    ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-    ::close(fd);
-    return ntohs(address.sin_port);
-}
 
 /// socat as a device server in "TCP server" mode in front of @p tty; killed by PID.
 class Socat {
@@ -127,7 +113,7 @@ int run(double run_seconds, std::uint32_t baud) {
         bench::line_limit(bench::LoadShape(bench::LoadShape::Kind::xeg), baud, milliseconds{1});
     SimProcess sim({"--bus", "{dir}/line-pty:hiwin-xeg@2", "--bus", "{dir}/line-tcp:hiwin-xeg@2", "--wire-time",
                     "--baud", std::to_string(baud), "--turnaround", "1ms"});
-    const std::uint16_t port = free_port();
+    const std::uint16_t port = test::free_loopback_port();  // socat binds it right after
     Socat socat(port, sim.path("line-tcp"));
     EngineHarness h(engine_yaml(sim.path("line-pty"), port, baud));
     h.start();

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include <mqtt/async_client.h>
+#include "free_port.hpp"
 #include "temp_dir.hpp"
 
 extern char** environ;
@@ -33,19 +34,7 @@ sockaddr_in loopback(int port) {
 
 }  // namespace
 
-int free_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    if (fd < 0) throw std::runtime_error("socket() failed");
-    sockaddr_in a = loopback(0);
-    if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-        ::close(fd);
-        throw std::runtime_error("bind() failed");
-    }
-    socklen_t len = sizeof a;
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-    ::close(fd);
-    return ntohs(a.sin_port);
-}
+int free_port() { return fieldbridge::test::free_loopback_port(); }
 
 bool wait_for_listener(int port, std::chrono::milliseconds timeout) {
     const auto until = std::chrono::steady_clock::now() + timeout;
