@@ -93,7 +93,7 @@ TEST_CASE("DBIRTH: every metric with name, alias, datatype and current value; se
     CHECK(position.timestamp);
 }
 
-TEST_CASE("with aliases off, births carry names only") {
+TEST_CASE("with aliases off, births and DDATA carry names only") {
     Clock clock;
     ss::SessionSettings s = settings();
     s.aliases = false;
@@ -103,6 +103,10 @@ TEST_CASE("with aliases off, births carry names only") {
     for (const auto& pub : only<ss::Publish>(session.connected(clock.now()))) {
         for (const sp::Metric& m : pub.payload.metrics) CHECK_FALSE(m.alias);
     }
+    const auto pubs = only<ss::Publish>(session.device_changed("xeg1", {change("position_mm", 10, 7.0)}, clock.advance(1s)));
+    REQUIRE(pubs.size() == 1);
+    CHECK(pubs[0].payload.metrics[0].name == "position_mm");
+    CHECK_FALSE(pubs[0].payload.metrics[0].alias);
 }
 
 TEST_CASE("seq goes +1 on every message but NDEATH and wraps 255 -> 0 (tck-id-payloads-sequence-num-incrementing)") {

@@ -28,20 +28,6 @@ TEST_CASE("DDATA carries the changed metrics by alias only, without datatype, Qo
     CHECK_FALSE(m.is_historical);
 }
 
-TEST_CASE("with aliases off DDATA names its metrics") {
-    Clock clock;
-    ss::SessionSettings s = settings();
-    s.aliases = false;
-    ss::Session session = make_session(s);
-    static_cast<void>(session.device_online("xeg1", xeg_metrics(), clock.now()));
-    static_cast<void>(session.connecting(0));
-    static_cast<void>(session.connected(clock.now()));
-    const auto pubs = only<ss::Publish>(session.device_changed("xeg1", {change("position_mm", 10, 7.0)}, clock.advance(1s)));
-    REQUIRE(pubs.size() == 1);
-    CHECK(pubs[0].payload.metrics[0].name == "position_mm");
-    CHECK_FALSE(pubs[0].payload.metrics[0].alias);
-}
-
 TEST_CASE("no DDATA before the births (tck-id-message-flow-edge-node-birth-publish-connect)") {
     Clock clock;
     ss::Session session = make_session();
