@@ -44,9 +44,11 @@ void MqttComponent::build() {
     // Throws (with the URI) when the client library refuses the configuration: the
     // daemon then refuses to start.
     auto client = clients_(io_, settings, settings.prefix + "/status");
-    // The URI was validated with the configuration; an unparsable one only loses the probe.
+    // The URI was validated with the configuration; an unparsable one only loses the
+    // probe. With several brokers the probe of one would not say whether the next
+    // attempt's is up: back-off only.
     std::unique_ptr<mqtt::BrokerProbe> probe;
-    if (const auto uri = config::parse_mqtt_uri(settings.uri)) {
+    if (const auto uri = config::parse_mqtt_uri(settings.uris.front()); uri && settings.uris.size() == 1) {
         probe = std::make_unique<mqtt::TcpBrokerProbe>(io_, uri.value->host, uri.value->port);
     }
     bridge_ = std::make_unique<mqtt::Bridge>(io_, mqtt::bridge_settings(settings), std::move(client),
@@ -62,7 +64,9 @@ void MqttComponent::build() {
     });
     if (!refresh_pending_) refresh_sources();
     bridge_->start();
-    logger_->info("MQTT: broker {}, client id {}, prefix {}, MQTT {}", settings.uri, settings.client_id, settings.prefix,
+    std::string brokers;
+    for (const std::string& uri : settings.uris) brokers += (brokers.empty() ? "" : ", ") + uri;
+    logger_->info("MQTT: broker {}, client id {}, prefix {}, MQTT {}", brokers, settings.client_id, settings.prefix,
                   config::to_string(settings.version));
 }
 

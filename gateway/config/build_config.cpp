@@ -1,5 +1,6 @@
 #include "config/build_config.hpp"
 
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 
@@ -168,11 +169,92 @@ void set(T& target, const Field<T>& field) {
     return upstream;
 }
 
+/// The password from @p path (when set) into @p password.
+void read_password_file(const Field<std::string>& field, const std::string& path, std::string& password,
+                        DiagnosticSink& sink) {
+    if (path.empty()) {
+        return;
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        sink.error(field, "cannot read " + path + "; check that the service user may read it");
+    }
+    std::string secret((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // One trailing newline is what `echo secret > file` leaves: it is not part of
+    // the password.
+    if (!secret.empty() && secret.back() == '\n') {
+        secret.pop_back();
+        if (!secret.empty() && secret.back() == '\r') {
+            secret.pop_back();
+        }
+    }
+    password = std::move(secret);
+}
+
+[[nodiscard]] MqttTlsConfig build_tls(const RawTls& raw, const std::filesystem::path& base_dir) {
+    MqttTlsConfig tls;
+    tls.ca_file = resolved_file(raw.ca_file, base_dir);
+    tls.cert_file = resolved_file(raw.cert_file, base_dir);
+    tls.key_file = resolved_file(raw.key_file, base_dir);
+    set(tls.verify, raw.verify);
+    return tls;
+}
+
+/// $STATE_DIRECTORY (systemd: one or more paths separated by ':'; the first is ours),
+/// else the packaged default.
+[[nodiscard]] std::string default_state_dir() {
+    const char* from_systemd = std::getenv("STATE_DIRECTORY");
+    if (from_systemd == nullptr || *from_systemd == '\0') {
+        return SparkplugConfig::default_state_dir;
+    }
+    const std::string_view list(from_systemd);
+    return std::string(list.substr(0, list.find(':')));
+}
+
+[[nodiscard]] std::optional<SparkplugConfig> build_sparkplug(const RawSparkplug& raw, const std::string& gateway_id,
+                                                             const std::filesystem::path& base_dir,
+                                                             DiagnosticSink& sink) {
+    if (!raw.ok()) {
+        return std::nullopt;
+    }
+    SparkplugConfig sparkplug;
+    for (const auto& server : raw.servers.items) {
+        if (server.has_value()) {
+            sparkplug.servers.push_back(*server);
+        }
+    }
+    sparkplug.client_id = raw.client_id.value_or("");
+    if (sparkplug.client_id.empty()) {
+        sparkplug.client_id = "fieldbridge-" + gateway_id + "-sparkplug";
+    }
+    sparkplug.group_id = raw.group_id.value_or("");
+    sparkplug.edge_node_id = raw.edge_node_id.value_or(gateway_id);
+    set(sparkplug.primary_host_id, raw.primary_host_id);
+    set(sparkplug.username, raw.username);
+    set(sparkplug.password, raw.password);
+    sparkplug.password_file = resolved_file(raw.password_file, base_dir);
+    read_password_file(raw.password_file, sparkplug.password_file, sparkplug.password, sink);
+    sparkplug.tls = build_tls(raw.tls, base_dir);
+    set(sparkplug.keep_alive, raw.keep_alive);
+    set(sparkplug.aliases, raw.aliases);
+    auto& buffer = sparkplug.offline_buffer;
+    buffer.max_messages = narrow<std::size_t>(raw.offline_buffer.max_messages, buffer.max_messages);
+    buffer.max_bytes = narrow<std::size_t>(raw.offline_buffer.max_bytes, buffer.max_bytes);
+    sparkplug.state_dir = raw.state_dir.has_value() ? resolve_path(base_dir, *raw.state_dir).string()
+                                                    : default_state_dir();
+    return sparkplug;
+}
+
 [[nodiscard]] MqttConfig build_mqtt(const RawMqtt& raw, const std::string& gateway_id,
                                     const std::filesystem::path& base_dir, DiagnosticSink& sink) {
     MqttConfig mqtt;
     mqtt.enabled = raw.ok() && raw.enabled.value_or(true);
-    set(mqtt.uri, raw.uri);
+    if (!raw.uri.items.empty()) {
+        mqtt.uris.clear();
+        for (const auto& item : raw.uri.items) {
+            if (item.has_value()) mqtt.uris.push_back(*item);
+        }
+    }
     mqtt.client_id = raw.client_id.value_or("");
     if (mqtt.client_id.empty()) {
         mqtt.client_id = "fieldbridge-" + gateway_id;
@@ -180,27 +262,8 @@ void set(T& target, const Field<T>& field) {
     set(mqtt.username, raw.username);
     set(mqtt.password, raw.password);
     mqtt.password_file = resolved_file(raw.password_file, base_dir);
-    if (!mqtt.password_file.empty()) {
-        std::ifstream in(mqtt.password_file, std::ios::binary);
-        if (!in) {
-            sink.error(raw.password_file, "cannot read " + mqtt.password_file +
-                                              "; check that the service user may read it");
-        }
-        std::string secret((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        // One trailing newline is what `echo secret > file` leaves: it is not part of
-        // the password.
-        if (!secret.empty() && secret.back() == '\n') {
-            secret.pop_back();
-            if (!secret.empty() && secret.back() == '\r') {
-                secret.pop_back();
-            }
-        }
-        mqtt.password = std::move(secret);
-    }
-    mqtt.tls.ca_file = resolved_file(raw.tls.ca_file, base_dir);
-    mqtt.tls.cert_file = resolved_file(raw.tls.cert_file, base_dir);
-    mqtt.tls.key_file = resolved_file(raw.tls.key_file, base_dir);
-    set(mqtt.tls.verify, raw.tls.verify);
+    read_password_file(raw.password_file, mqtt.password_file, mqtt.password, sink);
+    mqtt.tls = build_tls(raw.tls, base_dir);
     mqtt.qos = static_cast<int>(raw.qos.value_or(mqtt.qos));
     set(mqtt.keep_alive, raw.keep_alive);
     set(mqtt.clean_session, raw.clean_session);
@@ -241,6 +304,7 @@ Config build_config(const RawConfig& raw, const std::filesystem::path& base_dir,
         config.upstreams.push_back(build_upstream(upstream));
     }
     config.mqtt = build_mqtt(raw.mqtt, config.gateway.id, base_dir, sink);
+    config.sparkplug = build_sparkplug(raw.sparkplug, config.gateway.id, base_dir, sink);
     if (raw.metrics_http.ok()) {
         MetricsHttpConfig metrics;
         set(metrics.listen, raw.metrics_http.listen);

@@ -93,6 +93,12 @@ std::chrono::nanoseconds LineConfig::character_time() const noexcept {
     return std::chrono::nanoseconds{(std::int64_t{bits_per_character()} * 1'000'000'000 + baud - 1) / baud};
 }
 
-bool MqttConfig::uses_tls() const noexcept { return uri.starts_with("ssl://") || uri.starts_with("wss://"); }
+bool MqttConfig::uses_tls() const noexcept {
+    return !uris.empty() && (uris.front().starts_with("ssl://") || uris.front().starts_with("wss://"));
+}
+
+bool SparkplugConfig::uses_tls() const noexcept {
+    return std::any_of(servers.begin(), servers.end(), [](const std::string& uri) { return uri.starts_with("ssl://"); });
+}
 
 }  // namespace fieldbridge::config

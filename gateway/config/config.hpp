@@ -327,7 +327,9 @@ struct MqttTlsConfig {
 struct MqttConfig {
     /// False when the `mqtt` section is absent; true by default when it is present.
     bool enabled = false;
-    std::string uri = "tcp://127.0.0.1:1883";  ///< tcp:// | ssl:// | ws:// | wss://
+    /// tcp:// | ssl:// | ws:// | wss://; mqtt.uri, one or a list: tried in order
+    /// (the next after a failed attempt or a lost connection); all TLS or none.
+    std::vector<std::string> uris{"tcp://127.0.0.1:1883"};
     std::string client_id;  ///< resolved: "fieldbridge-<gateway id>" when not set
     std::string username;   ///< empty: none
     std::string password;   ///< resolved: the content of password_file when that is set
@@ -369,9 +371,47 @@ struct MqttConfig {
     static constexpr std::size_t max_client_id_length = 128;
     static constexpr std::size_t max_prefix_length = 256;
 
-    /// ssl:// or wss://.
+    /// ssl:// or wss:// (the first URI; all of them are the same on this).
     [[nodiscard]] bool uses_tls() const noexcept;
     bool operator==(const MqttConfig&) const = default;
+};
+
+/// The Sparkplug B edge node's offline buffer (docs/sparkplug-session.md): data kept
+/// while no session can carry it. The defaults fit a 512 MB box: 16 MiB is about 3 %
+/// of its memory, and holds some 4 minutes of 64 devices changing every second (half
+/// an hour for a box of 8).
+struct SparkplugOfflineBufferConfig {
+    std::size_t max_messages = 20000;
+    static constexpr Range<std::int64_t> max_messages_range{1, 1000000};
+    std::size_t max_bytes = 16 * 1024 * 1024;
+    static constexpr Range<std::int64_t> max_bytes_range{64 * 1024, 256 * 1024 * 1024};
+    bool operator==(const SparkplugOfflineBufferConfig&) const = default;
+};
+
+/// The Sparkplug B edge node (docs/sparkplug-session.md, docs/configuration.md): its own
+/// MQTT connection beside the JSON bridge. Present only when the section is.
+struct SparkplugConfig {
+    std::vector<std::string> servers;  ///< tcp:// | ssl://, tried in order; at least one
+    std::string client_id;             ///< resolved: "fieldbridge-<gateway id>-sparkplug" when not set
+    std::string group_id;
+    std::string edge_node_id;          ///< resolved: the gateway id when not set
+    std::string primary_host_id;       ///< empty: no primary host
+    std::string username;              ///< empty: none
+    std::string password;              ///< resolved: the content of password_file when that is set
+    std::string password_file;         ///< absolute path, or empty
+    MqttTlsConfig tls;                 ///< file paths resolved to absolute paths
+    milliseconds keep_alive = seconds{30};  ///< whole seconds; 0 disables
+    static constexpr Range<milliseconds> keep_alive_range{milliseconds{0}, seconds{65535}};
+    bool aliases = true;
+    SparkplugOfflineBufferConfig offline_buffer;
+    /// Where the bdSeq file lives. Resolved: $STATE_DIRECTORY (systemd's
+    /// StateDirectory=; its first path) when not set, else /var/lib/fieldbridge.
+    std::string state_dir;
+    static constexpr const char* default_state_dir = "/var/lib/fieldbridge";
+
+    /// True when a server is ssl://.
+    [[nodiscard]] bool uses_tls() const noexcept;
+    bool operator==(const SparkplugConfig&) const = default;
 };
 
 /// Prometheus text endpoint.
@@ -386,6 +426,7 @@ struct Config {
     std::vector<LineConfig> lines;
     std::vector<UpstreamConfig> upstreams;
     MqttConfig mqtt;
+    std::optional<SparkplugConfig> sparkplug;       ///< absent: no Sparkplug edge node
     std::optional<MetricsHttpConfig> metrics_http;  ///< absent: no HTTP endpoint
     std::string source_file;                        ///< the file it was loaded from
     bool operator==(const Config&) const = default;

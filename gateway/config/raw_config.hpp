@@ -266,7 +266,7 @@ struct RawDeadband : RawNode {
 
 struct RawMqtt : RawNode {
     Field<bool> enabled;
-    Field<std::string> uri;
+    FieldList<std::string> uri;  ///< one URI or a list; a single one is an item at path "mqtt.uri"
     Field<std::string> client_id;
     Field<std::string> username;
     Field<std::string> password;
@@ -290,6 +290,27 @@ struct RawMqtt : RawNode {
     Field<std::int64_t> outbox_max_messages;
 };
 
+struct RawOfflineBuffer : RawNode {
+    Field<std::int64_t> max_messages;
+    Field<std::int64_t> max_bytes;
+};
+
+struct RawSparkplug : RawNode {
+    FieldList<std::string> servers;
+    Field<std::string> client_id;
+    Field<std::string> group_id;
+    Field<std::string> edge_node_id;
+    Field<std::string> primary_host_id;
+    Field<std::string> username;
+    Field<std::string> password;
+    Field<std::string> password_file;
+    RawTls tls;
+    Field<std::chrono::milliseconds> keep_alive;
+    Field<bool> aliases;
+    RawOfflineBuffer offline_buffer;
+    Field<std::string> state_dir;
+};
+
 struct RawMetricsHttp : RawNode {
     Field<ListenAddress> listen;
 };
@@ -300,6 +321,7 @@ struct RawConfig : RawNode {
     RawSeq<RawLine> lines;
     RawSeq<RawUpstream> upstreams;
     RawMqtt mqtt;
+    RawSparkplug sparkplug;
     RawMetricsHttp metrics_http;
     FieldList<std::string> definitions;  ///< directories of device definition files
 };

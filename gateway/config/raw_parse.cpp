@@ -113,6 +113,23 @@ RawDeadband parse_deadband(const NodeRef& ref, DiagnosticSink& sink) {
     return raw;
 }
 
+/// A text or a list of texts: a single one becomes a list of one, at the key's own path.
+FieldList<std::string> read_one_or_list(const MapReader& map, std::string_view key, std::string_view what) {
+    const NodeRef ref = map.child(key);
+    if (ref.node && ref.node->IsSequence()) {
+        return read_list<std::string>(map, key, what,
+                                      [](std::string_view text) { return Parsed<std::string>::ok(std::string(text)); });
+    }
+    FieldList<std::string> list;
+    list.path = ref.path;
+    list.mark = ref.mark;
+    Field<std::string> one = read_string(map, key);
+    if (one.absent()) return list;
+    list.state = one.invalid ? RawNode::State::invalid : RawNode::State::ok;
+    list.items.push_back(std::move(one));
+    return list;
+}
+
 RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"enabled", "uri", "client_id", "username", "password", "password_file", "tls", "qos",
@@ -124,7 +141,7 @@ RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
     RawMqtt raw;
     map.fill(raw);
     raw.enabled = read_bool(map, "enabled");
-    raw.uri = read_string(map, "uri");
+    raw.uri = read_one_or_list(map, "uri", "broker URIs (tcp://host:1883, ssl://host:8883)");
     raw.client_id = read_string(map, "client_id");
     raw.username = read_string(map, "username");
     raw.password = read_string(map, "password");
@@ -149,6 +166,39 @@ RawMqtt parse_mqtt(const NodeRef& ref, DiagnosticSink& sink) {
     return raw;
 }
 
+RawOfflineBuffer parse_offline_buffer(const NodeRef& ref, DiagnosticSink& sink) {
+    const MapReader map(ref, {"max_messages", "max_bytes"}, sink);
+    RawOfflineBuffer raw;
+    map.fill(raw);
+    raw.max_messages = read_int(map, "max_messages");
+    raw.max_bytes = read_int(map, "max_bytes");
+    return raw;
+}
+
+RawSparkplug parse_sparkplug(const NodeRef& ref, DiagnosticSink& sink) {
+    const MapReader map(ref,
+                        {"servers", "client_id", "group_id", "edge_node_id", "primary_host_id", "username",
+                         "password", "password_file", "tls", "keep_alive", "aliases", "offline_buffer", "state_dir"},
+                        sink);
+    RawSparkplug raw;
+    map.fill(raw);
+    raw.servers = read_list<std::string>(map, "servers", "server URIs (tcp://host:1883, ssl://host:8883)",
+                                         [](std::string_view text) { return Parsed<std::string>::ok(std::string(text)); });
+    raw.client_id = read_string(map, "client_id");
+    raw.group_id = read_string(map, "group_id");
+    raw.edge_node_id = read_string(map, "edge_node_id");
+    raw.primary_host_id = read_string(map, "primary_host_id");
+    raw.username = read_string(map, "username");
+    raw.password = read_string(map, "password");
+    raw.password_file = read_string(map, "password_file");
+    raw.tls = parse_tls(map.child("tls"), sink);
+    raw.keep_alive = read_duration(map, "keep_alive");
+    raw.aliases = read_bool(map, "aliases");
+    raw.offline_buffer = parse_offline_buffer(map.child("offline_buffer"), sink);
+    raw.state_dir = read_string(map, "state_dir");
+    return raw;
+}
+
 RawMetricsHttp parse_metrics_http(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref, {"listen"}, sink);
     RawMetricsHttp raw;
@@ -170,8 +220,9 @@ RawBackoff parse_backoff(const NodeRef& ref, DiagnosticSink& sink) {
 
 RawConfig parse_raw(const YAML::Node& root, DiagnosticSink& sink) {
     const NodeRef root_ref{root, "", to_mark(root.Mark(), Mark{1, 1})};
-    const MapReader map(root_ref, {"gateway", "modbus_tcp", "lines", "upstreams", "mqtt", "metrics_http", "definitions"}, sink,
-                        true);
+    const MapReader map(root_ref, {"gateway", "modbus_tcp", "lines", "upstreams", "mqtt", "metrics_http", "sparkplug",
+                                          "definitions"},
+                        sink, true);
     RawConfig raw;
     map.fill(raw);
     raw.gateway = parse_gateway(map.child("gateway"), sink);
@@ -179,6 +230,7 @@ RawConfig parse_raw(const YAML::Node& root, DiagnosticSink& sink) {
     raw.lines = parse_lines(map);
     raw.upstreams = read_seq<RawUpstream>(map, "upstreams", parse_upstream);
     raw.mqtt = parse_mqtt(map.child("mqtt"), sink);
+    raw.sparkplug = parse_sparkplug(map.child("sparkplug"), sink);
     raw.metrics_http = parse_metrics_http(map.child("metrics_http"), sink);
     raw.definitions = read_list<std::string>(map, "definitions", "directories of device definition files",
                                              [](std::string_view text) { return Parsed<std::string>::ok(std::string(text)); });

@@ -14,6 +14,7 @@ void validate(const RawConfig& raw, const std::filesystem::path& base_dir, Diagn
     validate_network(raw, sink);
     validate_lines(raw, sink);
     validate_mqtt(raw.mqtt, base_dir, sink);
+    validate_sparkplug(raw, base_dir, sink);
     validate_uniqueness(raw, sink);
 }
 

@@ -30,6 +30,27 @@ void validate_devices(const RawLine& line, DiagnosticSink& sink);     // validat
 void validate_network(const RawConfig& raw, DiagnosticSink& sink);    // validate_network.cpp
 void validate_mqtt(const RawMqtt& mqtt, const std::filesystem::path& base_dir, DiagnosticSink& sink);
 void validate_uniqueness(const RawConfig& raw, DiagnosticSink& sink);  // validate_uniqueness.cpp
+void validate_sparkplug(const RawConfig& raw, const std::filesystem::path& base_dir,
+                        DiagnosticSink& sink);                         // validate_sparkplug.cpp
+
+// ---- MQTT connection settings, shared by mqtt and sparkplug (validate_mqtt.cpp) ----
+
+struct MqttCredentialFields {
+    const Field<std::string>& username;
+    const Field<std::string>& password;
+    const Field<std::string>& password_file;
+    std::string_view version_hint;  ///< appended to "expected username to be set too"
+};
+/// password and password_file not both; the file readable; a password needs a
+/// username in MQTT 3.1.1.
+void check_mqtt_credentials(const MqttCredentialFields& fields, MqttVersion version,
+                            const std::filesystem::path& base_dir, DiagnosticSink& sink);
+/// The TLS files exist; key_file needs cert_file; TLS settings need a TLS URI
+/// (@p tls_uri), else @p uri_hint is reported.
+void check_mqtt_tls(const RawTls& tls, bool tls_uri, std::string_view uri_hint, const std::filesystem::path& base_dir,
+                    DiagnosticSink& sink);
+/// 1..128 printable characters without spaces.
+void check_mqtt_client_id(const Field<std::string>& client_id, DiagnosticSink& sink);
 
 // ---- shared helpers ----------------------------------------------------------------
 

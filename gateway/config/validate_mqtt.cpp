@@ -29,34 +29,35 @@ bool check_file(const Field<std::string>& field, const std::filesystem::path& ba
     return true;
 }
 
-void check_credentials(const RawMqtt& mqtt, const std::filesystem::path& base_dir, DiagnosticSink& sink) {
-    const bool has_password = mqtt.password.has_value() && !mqtt.password->empty();
-    const bool has_password_file = mqtt.password_file.has_value() && !mqtt.password_file->empty();
+}  // namespace
+
+void check_mqtt_credentials(const MqttCredentialFields& fields, MqttVersion version,
+                            const std::filesystem::path& base_dir, DiagnosticSink& sink) {
+    const bool has_password = fields.password.has_value() && !fields.password->empty();
+    const bool has_password_file = fields.password_file.has_value() && !fields.password_file->empty();
     if (has_password && has_password_file) {
-        sink.error(mqtt.password_file, "password and password_file are both set; expected only one of them "
-                                       "(password_file keeps the secret out of this file)");
+        sink.error(fields.password_file, "password and password_file are both set; expected only one of them "
+                                         "(password_file keeps the secret out of this file)");
     }
-    if (check_file(mqtt.password_file, base_dir, sink)) {
-        const auto path = resolve_path(base_dir, *mqtt.password_file);
+    if (check_file(fields.password_file, base_dir, sink)) {
+        const auto path = resolve_path(base_dir, *fields.password_file);
         std::ifstream in(path);
         if (!in) {
-            sink.error(mqtt.password_file, "cannot read " + path.string() +
-                                               "; check that the service user may read it");
+            sink.error(fields.password_file, "cannot read " + path.string() +
+                                                 "; check that the service user may read it");
         }
     }
-    const bool has_username = mqtt.username.has_value() && !mqtt.username->empty();
-    const MqttVersion version = mqtt.version.value_or(MqttConfig{}.version);
+    const bool has_username = fields.username.has_value() && !fields.username->empty();
     if ((has_password || has_password_file) && !has_username && version == MqttVersion::v3_1_1) {
         // MQTT 3.1.1 section 3.1.2.9: a password without a user name is not allowed.
-        const auto& culprit = has_password ? mqtt.password : mqtt.password_file;
-        sink.error(culprit, "a password needs a username in MQTT 3.1.1; expected username to be set too (or "
-                            "version: \"5\")");
+        const auto& culprit = has_password ? fields.password : fields.password_file;
+        sink.error(culprit, "a password needs a username in MQTT 3.1.1; expected username to be set too" +
+                                std::string(fields.version_hint));
     }
 }
 
-void check_tls(const RawMqtt& mqtt, const std::optional<MqttUri>& uri, const std::filesystem::path& base_dir,
-               DiagnosticSink& sink) {
-    const RawTls& tls = mqtt.tls;
+void check_mqtt_tls(const RawTls& tls, bool tls_uri, std::string_view uri_hint, const std::filesystem::path& base_dir,
+                    DiagnosticSink& sink) {
     if (!tls.ok()) {
         return;
     }
@@ -69,22 +70,27 @@ void check_tls(const RawMqtt& mqtt, const std::optional<MqttUri>& uri, const std
     }
     const bool tls_settings = set(tls.ca_file) || set(tls.cert_file) || set(tls.key_file) ||
                               (tls.verify.has_value() && !*tls.verify);
-    if (tls_settings && uri && !uri->tls()) {
-        sink.error(tls, "TLS settings need an ssl:// or wss:// uri, but the uri is " + uri->scheme +
-                            "://...; expected uri: ssl://host:8883 (or remove tls)");
+    if (tls_settings && !tls_uri) {
+        sink.error(tls, std::string(uri_hint));
     }
 }
 
-void check_topics(const RawMqtt& mqtt, DiagnosticSink& sink) {
-    if (mqtt.client_id.has_value() && !mqtt.client_id->empty()) {
-        const auto& id = *mqtt.client_id;
+void check_mqtt_client_id(const Field<std::string>& client_id, DiagnosticSink& sink) {
+    if (client_id.has_value() && !client_id->empty()) {
+        const auto& id = *client_id;
         const bool printable = std::all_of(id.begin(), id.end(), [](char c) { return c > ' ' && c < 127; });
         if (!printable || id.size() > MqttConfig::max_client_id_length) {
-            sink.error(mqtt.client_id, "'" + id + "' is not a usable client id; expected 1.." +
-                                           std::to_string(MqttConfig::max_client_id_length) +
-                                           " printable characters without spaces");
+            sink.error(client_id, "'" + id + "' is not a usable client id; expected 1.." +
+                                      std::to_string(MqttConfig::max_client_id_length) +
+                                      " printable characters without spaces");
         }
     }
+}
+
+namespace {
+
+void check_topics(const RawMqtt& mqtt, DiagnosticSink& sink) {
+    check_mqtt_client_id(mqtt.client_id, sink);
     if (mqtt.prefix.has_value() && !mqtt.prefix->empty()) {
         const auto& prefix = *mqtt.prefix;
         std::string problem;
@@ -127,16 +133,35 @@ void validate_mqtt(const RawMqtt& mqtt, const std::filesystem::path& base_dir, D
     if (!mqtt.ok()) {
         return;
     }
-    std::optional<MqttUri> uri = parse_mqtt_uri(MqttConfig{}.uri).value;
-    if (mqtt.uri.has_value()) {
-        auto parsed = parse_mqtt_uri(*mqtt.uri);
-        if (!parsed) {
-            sink.error(mqtt.uri, std::move(parsed.error));
-        }
-        uri = std::move(parsed.value);
+    std::optional<MqttUri> uri = parse_mqtt_uri(MqttConfig{}.uris.front()).value;
+    if (mqtt.uri.ok() && mqtt.uri.items.empty()) {
+        sink.error(mqtt.uri, "the list is empty; expected at least one broker, e.g. tcp://broker:1883");
     }
-    check_credentials(mqtt, base_dir, sink);
-    check_tls(mqtt, uri, base_dir, sink);
+    std::optional<MqttUri> first;
+    for (const auto& item : mqtt.uri.items) {
+        if (!item.has_value()) continue;
+        auto parsed = parse_mqtt_uri(*item);
+        if (!parsed) {
+            sink.error(item, std::move(parsed.error));
+            uri.reset();  // no TLS verdict on a URI that does not parse
+            continue;
+        }
+        if (!first) {
+            first = parsed.value;
+        } else if (parsed.value->tls() != first->tls()) {
+            // One client, one TLS set-up: the brokers of a list all use TLS or none does.
+            sink.error(item, "'" + *item + "' " + (parsed.value->tls() ? "uses" : "does not use") +
+                                 " TLS and the first URI " + (first->tls() ? "does" : "does not") +
+                                 "; expected every URI of the list with TLS (ssl://, wss://) or none");
+        }
+    }
+    if (first) uri = std::move(first);
+    check_mqtt_credentials({mqtt.username, mqtt.password, mqtt.password_file, " (or version: \"5\")"},
+                           mqtt.version.value_or(MqttConfig{}.version), base_dir, sink);
+    check_mqtt_tls(mqtt.tls, !uri || uri->tls(),
+                   "TLS settings need an ssl:// or wss:// uri, but the uri is " + (uri ? uri->scheme : std::string("?")) +
+                       "://...; expected uri: ssl://host:8883 (or remove tls)",
+                   base_dir, sink);
     check_topics(mqtt, sink);
     check_range(sink, mqtt.qos, MqttConfig::qos_range);
     if (check_range(sink, mqtt.keep_alive, MqttConfig::keep_alive_range) && mqtt.keep_alive->count() % 1000 != 0) {

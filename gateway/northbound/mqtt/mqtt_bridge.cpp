@@ -209,9 +209,19 @@ private:
         pump();
     }
 
+    /// mqtt.uri as a list: after a failed attempt or a lost connection, the next
+    /// broker of the list (wrapping to the first) gets the next attempt.
+    void walk_to_next_server() {
+        const std::size_t count = client_->server_count();
+        if (count < 2) return;
+        server_ = (server_ + 1) % count;
+        client_->select_server(server_);
+    }
+
     void on_connect_failed(const std::string& reason) {
         ++stats_.connect_failures;
         if (stopping_) return;
+        walk_to_next_server();
         const auto delay = reconnect_.schedule();
         log(LogLevel::warning, "MQTT: cannot connect to the broker (" + reason + "); retrying in " +
                                    std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(delay).count()) +
@@ -229,6 +239,7 @@ private:
         in_flight_.clear();
         if (stopping_) return;
         log(LogLevel::warning, "MQTT: connection to the broker lost (" + cause + "); reconnecting");
+        walk_to_next_server();
         reconnect_.schedule();
     }
 
@@ -564,6 +575,7 @@ private:
     ReconnectSchedule reconnect_;
     bool started_ = false;
     bool stopping_ = false;
+    std::size_t server_ = 0;  ///< the client's server of the next attempt (mqtt.uri as a list)
     bool wake_armed_ = false;
     engine::TimePoint wake_at_{};
     std::optional<engine::TimePoint> device_wake_;

@@ -12,7 +12,8 @@
 /// the next one (at least once). A lost connection or a failed attempt is retried
 /// after a back-off (doubling from `reconnect_initial` up to `reconnect_max`), or as
 /// soon as a probe sees a broker that was down accept connections again
-/// (ReconnectSchedule).
+/// (ReconnectSchedule); with several brokers (mqtt.uri as a list) each failed attempt
+/// and each lost connection moves to the next one, wrapping to the first.
 // Standard headers before asio's (see daemon/periodic.hpp).
 #include <chrono>
 #include <cstdint>

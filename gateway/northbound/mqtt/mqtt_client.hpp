@@ -3,6 +3,7 @@
 /// The seam between the bridge and an MQTT client library (paho_client.hpp is the
 /// real one). Every event is delivered on the gateway's loop thread; no call blocks.
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -51,6 +52,10 @@ public:
     /// @p done runs on the loop thread afterwards, whatever happened.
     virtual void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) = 0;
     [[nodiscard]] virtual bool connected() const = 0;
+    /// The brokers this client can connect to (mqtt.uri as a list), tried in order.
+    [[nodiscard]] virtual std::size_t server_count() const { return 1; }
+    /// The broker the next connect() goes to: 0 .. server_count() - 1.
+    virtual void select_server(std::size_t index) { static_cast<void>(index); }
     /// The process is ending: a client that is not connected may leave its library
     /// state to the process exit instead of tearing it down in its destructor
     /// (PahoClient: paho.mqtt.c's last-client teardown races its worker threads).

@@ -58,7 +58,8 @@ void release_free_memory() noexcept {
 
 PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic) {
     PahoOptions o;
-    o.uri = config.uri;
+    o.uri = config.uris.front();
+    o.servers = config.uris;
     o.client_id = config.client_id;
     o.username = config.username;
     o.password = config.password;
@@ -297,6 +298,11 @@ void PahoClient::connect() {
         if (!o.username.empty()) options.set_user_name(o.username);
         if (!o.password.empty()) options.set_password(o.password);
         options.set_will(::mqtt::will_options(o.will.topic, o.will.payload, o.will.qos, o.will.retained));
+        if (server_ < o.servers.size()) {
+            // Replaces the URI the client was created with for this attempt (every
+            // server of the list has the same TLS-ness: the configuration checks it).
+            options.set_servers(::mqtt::string_collection::create(o.servers[server_]));
+        }
         if (o.tls) {
             ::mqtt::ssl_options ssl;
             if (!o.tls_files.ca_file.empty()) ssl.set_trust_store(o.tls_files.ca_file);
@@ -316,6 +322,12 @@ void PahoClient::connect() {
         });
     }
 }
+
+std::size_t PahoClient::server_count() const {
+    return std::max<std::size_t>(1, core_->options_.servers.size());
+}
+
+void PahoClient::select_server(std::size_t index) { server_ = index < server_count() ? index : 0; }
 
 std::uint64_t PahoClient::publish(const Message& message) {
     if (!core_->connected_) return 0;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <asio/io_context.hpp>
 
@@ -19,7 +20,10 @@
 namespace fieldbridge::northbound::mqtt {
 
 struct PahoOptions {
-    std::string uri = "tcp://127.0.0.1:1883";
+    std::string uri = "tcp://127.0.0.1:1883";  ///< the client is created with this one
+    /// The brokers to walk (mqtt.uri as a list; uri is the first); empty: uri only.
+    /// Each connection attempt goes to the one select_server() chose.
+    std::vector<std::string> servers;
     std::string client_id;
     std::string username;  ///< empty: none
     std::string password;  ///< empty: none
@@ -67,12 +71,15 @@ public:
     void subscribe(const std::string& filter, int qos) override;
     void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) override;
     [[nodiscard]] bool connected() const override;
+    [[nodiscard]] std::size_t server_count() const override;
+    void select_server(std::size_t index) override;
 
     class Core;
 
 private:
     std::shared_ptr<Core> core_;
     bool leave_to_exit_ = false;
+    std::size_t server_ = 0;
 };
 
 }  // namespace fieldbridge::northbound::mqtt

@@ -141,7 +141,7 @@ TEST_CASE("the demo configuration describes the demo cell") {
     CHECK(r6.units[0].name == "r6");
 
     CHECK(config->mqtt.enabled);
-    CHECK(config->mqtt.uri == "tcp://127.0.0.1:18830");
+    CHECK(config->mqtt.uris == std::vector<std::string>{"tcp://127.0.0.1:18830"});
     CHECK(config->mqtt.prefix == "fieldbridge/demo");
 }
 
@@ -231,7 +231,7 @@ metrics_http:
     REQUIRE(config);
     const auto& mqtt = config->mqtt;
     CHECK(mqtt.enabled);  // the section is present
-    CHECK(mqtt.uri == "tcp://127.0.0.1:1883");
+    CHECK(mqtt.uris == std::vector<std::string>{"tcp://127.0.0.1:1883"});
     CHECK(mqtt.client_id == "fieldbridge-cell-9");
     CHECK(mqtt.prefix == "fieldbridge/cell-9");
     CHECK(mqtt.username.empty());

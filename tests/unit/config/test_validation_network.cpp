@@ -223,3 +223,16 @@ TEST_CASE("metrics_http") {
     CHECK_REPORTS("gateway: {id: t}\nmetrics_http: {listen: nope}\n", "metrics_http.listen", 2, 24, "has no port");
     CHECK(diagnostics_of("gateway: {id: t}\nmetrics_http: {listen: \"127.0.0.1:9103\"}\n").empty());
 }
+
+TEST_CASE("mqtt.uri may be a list of brokers, tried in order; all with TLS or none") {
+    const auto config = load_ok("gateway: {id: t}\nmqtt:\n  uri: [tcp://a:1883, tcp://b:1884]\n");
+    CHECK(config->mqtt.uris == std::vector<std::string>{"tcp://a:1883", "tcp://b:1884"});
+    CHECK_FALSE(config->mqtt.uses_tls());
+    CHECK(load_ok("gateway: {id: t}\nmqtt:\n  uri: [ssl://a:8883, wss://b/mqtt]\n")->mqtt.uses_tls());
+    const std::string mixed = "gateway: {id: t}\nmqtt:\n  uri: [tcp://a:1883, ssl://b:8883]\n";
+    CHECK_REPORTS(mixed, "mqtt.uri[1]", 3, 23, "uses TLS and the first URI does not");
+    const std::string empty = "gateway: {id: t}\nmqtt:\n  uri: []\n";
+    CHECK_REPORTS(empty, "mqtt.uri", 3, 8, "the list is empty");
+    const std::string bad = "gateway: {id: t}\nmqtt:\n  uri: [tcp://a:1883, \"mqtt://b\"]\n";
+    CHECK_REPORTS(bad, "mqtt.uri[1]", 3, 23, "unsupported scheme 'mqtt'");
+}

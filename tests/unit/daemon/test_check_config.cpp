@@ -55,6 +55,15 @@ TEST_CASE("summaries count lines, devices and upstreams") {
     CHECK(daemon_ns::describe_config(*config_with(1, 0, 0, false)) == "1 line, 0 devices, MQTT disabled");
 }
 
+TEST_CASE("the summary names the Sparkplug group and edge node when the section is present") {
+    auto built = std::make_shared<config::Config>(*config_with(1, 0, 0, false));
+    built->sparkplug = config::SparkplugConfig{};
+    built->sparkplug->group_id = "plant1";
+    built->sparkplug->edge_node_id = "gw-7";
+    CHECK(daemon_ns::describe_config(*built) ==
+          "1 line, 0 devices, MQTT disabled, Sparkplug B configured (group plant1, edge node gw-7; not yet active)");
+}
+
 TEST_CASE("a valid file: one line on stdout, exit 0") {
     std::ostringstream out;
     std::ostringstream err;

@@ -1,5 +1,5 @@
 // The bridge over a scripted client: bounded in-flight and outbox while the broker is
-// slow, back-off of reconnection attempts, clean stop, retained commands refused,
+// slow, back-off of reconnection attempts, walking a list of brokers, clean stop, retained commands refused,
 // commands that depend on the device's registers.
 #include <doctest/doctest.h>
 
@@ -26,12 +26,16 @@ public:
         fm::ClientEvents events;
         bool connected = false;
         bool accept_connect = true;
+        std::size_t servers = 1;                  ///< brokers of the list
+        std::size_t server = 0;                   ///< the one select_server() chose
+        std::vector<std::size_t> connect_servers;  ///< the broker of each connect()
     };
     explicit ScriptedClient(asio::io_context& io, std::shared_ptr<Log> log) : io_(io), log_(std::move(log)) {}
 
     void set_events(fm::ClientEvents events) override { log_->events = std::move(events); }
     void connect() override {
         log_->connects.push_back(fe::Clock::now());
+        log_->connect_servers.push_back(log_->server);
         asio::post(io_, [log = log_] {
             if (log->accept_connect) {
                 log->connected = true;
@@ -54,6 +58,8 @@ public:
         asio::post(io_, std::move(done));
     }
     bool connected() const override { return log_->connected; }
+    std::size_t server_count() const override { return log_->servers; }
+    void select_server(std::size_t index) override { log_->server = index; }
 
 private:
     asio::io_context& io_;
@@ -134,6 +140,7 @@ TEST_CASE("bridge: reconnection attempts back off, doubling up to the maximum") 
     const fe::Duration expected[] = {20ms, 40ms, 80ms, 80ms, 80ms};
     for (std::size_t i = 0; i < 5; ++i) CHECK(log->connects[i + 1] - log->connects[i] >= expected[i]);
     CHECK(bridge.stats().connect_failures >= 5);
+    for (const std::size_t server : log->connect_servers) CHECK(server == 0);  // one broker: always it
     log->accept_connect = true;
     while (!bridge.connected() && std::chrono::steady_clock::now() < until + 1s) run(io, 5ms);
     CHECK(bridge.connected());
@@ -375,4 +382,30 @@ TEST_CASE("bridge: events in flight when the connection breaks are sent again fi
     }
     CHECK(events == std::vector<std::string>{"raised a1", "raised a1", "cleared a1"});
     CHECK(bridge.stats().resent == 1);
+}
+
+TEST_CASE("bridge: with several brokers, a failed attempt or a lost connection moves to the next one, wrapping") {
+    asio::io_context io;
+    auto log = std::make_shared<ScriptedClient::Log>();
+    log->servers = 3;
+    log->accept_connect = false;
+    fm::Bridge bridge(io, bridge_settings(), std::make_unique<ScriptedClient>(io, log));
+    bridge.start();
+    const auto until = std::chrono::steady_clock::now() + 2s;
+    while (log->connect_servers.size() < 4 && std::chrono::steady_clock::now() < until) run(io, 5ms);
+    REQUIRE(log->connect_servers.size() >= 4);
+    CHECK(log->connect_servers[0] == 0);
+    CHECK(log->connect_servers[1] == 1);
+    CHECK(log->connect_servers[2] == 2);
+    CHECK(log->connect_servers[3] == 0);
+    log->accept_connect = true;
+    while (!bridge.connected() && std::chrono::steady_clock::now() < until + 1s) run(io, 5ms);
+    REQUIRE(bridge.connected());
+    const std::size_t on = log->connect_servers.back();
+    const std::size_t attempts = log->connect_servers.size();
+    log->connected = false;
+    log->events.connection_lost("broker gone");
+    while (log->connect_servers.size() == attempts && std::chrono::steady_clock::now() < until + 2s) run(io, 5ms);
+    REQUIRE(log->connect_servers.size() > attempts);
+    CHECK(log->connect_servers.back() == (on + 1) % 3);
 }
