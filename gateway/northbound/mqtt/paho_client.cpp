@@ -298,9 +298,10 @@ void PahoClient::connect() {
         if (!o.username.empty()) options.set_user_name(o.username);
         if (!o.password.empty()) options.set_password(o.password);
         options.set_will(::mqtt::will_options(o.will.topic, o.will.payload, o.will.qos, o.will.retained));
-        if (server_ < o.servers.size()) {
-            // Replaces the URI the client was created with for this attempt (every
-            // server of the list has the same TLS-ness: the configuration checks it).
+        if (o.servers.size() > 1 && server_ < o.servers.size()) {
+            // A list: this attempt goes to the chosen broker instead of the URI the
+            // client was created with (every broker of the list has the same
+            // TLS-ness: the configuration checks it). One broker: as created.
             options.set_servers(::mqtt::string_collection::create(o.servers[server_]));
         }
         if (o.tls) {

@@ -1,6 +1,7 @@
 // The bridge with the real Paho client against a real mosquitto started by the test
 // (127.0.0.1, free port): availability, retained state, alarms, commands, broker
-// outage and return, clean stop, last will when the process is killed.
+// outage and return, a list of brokers whose first is absent, clean stop, last will
+// when the process is killed.
 #include <doctest/doctest.h>
 
 #include <signal.h>
@@ -275,6 +276,28 @@ TEST_CASE("bridge + mosquitto: a broker outage leaves the bridge running; state 
     REQUIRE(state);
     CHECK(rig.expect_json("g1/alarm", [](const json& j) { return j["event"] == "active"; }));
     CHECK(rig.bridge->stats().connects == 2);
+}
+
+TEST_CASE("bridge + mosquitto: with two brokers and the first absent, the bridge walks to the second") {
+    Mosquitto broker(free_port());
+    broker.start();
+    Observer observer(broker.uri(), "t7/gw/status");
+    asio::io_context io;
+    const std::string absent = "tcp://127.0.0.1:" + std::to_string(free_port());  // nothing listens
+    fm::PahoOptions o;
+    o.uri = absent;
+    o.servers = {absent, broker.uri()};
+    o.client_id = "fieldbridge-test-t7";
+    o.keep_alive = 5s;
+    o.will = fm::Message{"t7/gw/status", "offline", 1, true};
+    fm::Bridge bridge(io, settings("t7/gw"), std::make_unique<fm::PahoClient>(io, o));
+    bridge.start();
+    REQUIRE(run_until(io, [&] { return bridge.connected(); }));
+    CHECK(bridge.stats().connect_failures >= 1);
+    CHECK(observer.wait_for("t7/gw/status", [](const Received& r) { return r.payload == "online"; }, 5s));
+    bool stopped = false;
+    bridge.stop([&] { stopped = true; });
+    REQUIRE(run_until(io, [&] { return stopped; }));
 }
 
 TEST_CASE("bridge + mosquitto: a clean stop publishes offline") {
