@@ -42,6 +42,12 @@ std::optional<RowSpan> check_register(const RawRegister& row, DiagnosticSink& si
     const std::int64_t width = row.width.value_or(1);
     const std::int64_t count = row.count.value_or(1);
     require(sink, row.access, "read, write or read_write");
+    const bool read_only_table = row.table.has_value() && (*row.table == RegisterTable::input ||
+                                                            *row.table == RegisterTable::discrete_inputs);
+    if (read_only_table && row.access.has_value() && core::can_write(*row.access)) {
+        sink.error(row.access, std::string(core::to_string(*row.table)) +
+                                   " cannot be written over Modbus; expected access: read");
+    }
     const bool bits = row.table.has_value() && core::is_bit_table(*row.table);
     if (bits && width != 1) {
         sink.error(row.width, "a row of coils or discrete inputs is one bit wide; expected width: 1");

@@ -1,6 +1,5 @@
 #include "engine/profiles/excd_profile.hpp"
 
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>

@@ -467,3 +467,22 @@ TEST_CASE("behaviour: takes registers, not points; registers need behaviour:") {
     require_diagnostic(diagnostics_in(dir.path() / "gw.yaml", config_text("generic", "", "definitions: [devices]\n")),
                        generic, 3, 12, {"without behaviour: is a generic device"});
 }
+
+TEST_CASE("registers: rows of a read-only table are read-only; widths, counts and ranges are checked") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto file = dir.path() / "devices" / "hook.yaml";
+    write_file(file, "name: hook\n"
+                     "behaviour: wtec-rtu\n"
+                     "registers:\n"
+                     "  - {name: a, table: input, address: 0, access: read_write}\n"
+                     "  - {name: b, address: 1, width: 3, access: read}\n"
+                     "  - {name: c, address: 0xFFFF, width: 2, access: read}\n"
+                     "  - {name: d, address: 2, access: write, min: 5, max: 4}\n"
+                     "  - {name: e, table: coils, address: 0, width: 2, access: read}\n");
+    const auto diagnostics = diagnostics_in(dir.path() / "gw.yaml", config_text("hook", "", "definitions: [devices]\n"));
+    require_diagnostic(diagnostics, file, 4, 49, {"input cannot be written", "access: read"});
+    require_diagnostic(diagnostics, file, 5, 34, {"3 is out of range", "1..2"});
+    require_diagnostic(diagnostics, file, 6, 5, {"runs past register 0xFFFF"});
+    require_diagnostic(diagnostics, file, 7, 55, {"max 4 is below min 5"});
+    require_diagnostic(diagnostics, file, 8, 48, {"one bit wide"});
+}
