@@ -50,7 +50,8 @@ CommandResult decode_command(std::string_view bytes, const CommandLimits& limits
             return result;
         }
         command.metrics.push_back(
-            CommandMetric{MetricReference{std::move(metric.name), metric.alias}, metric.datatype, std::move(metric.value)});
+            CommandMetric{MetricReference{std::move(metric.name), metric.alias}, metric.datatype,
+                          std::move(metric.value)});
     }
     result.command = std::move(command);
     return result;

@@ -65,10 +65,6 @@ bool is_integer(DataType type) {
     }
 }
 
-const engine::Field* find_field(const engine::DecodedState& state, std::string_view name) {
-    return state.find(name);
-}
-
 const std::vector<CatalogueMetric> no_metrics;
 
 }  // namespace
@@ -211,11 +207,15 @@ std::vector<Metric> MetricCatalogue::birth_metrics(std::string_view device, cons
         if (aliases) metric.alias = known.alias;
         metric.timestamp = time_ms;
         metric.datatype = known.datatype;  // tck-id-payloads-metric-datatype-req
-        if (const engine::Field* field = find_field(state, known.field)) metric.value = metric_value(known, field->value);
+        if (const engine::Field* field = state.find(known.field)) {
+            metric.value = metric_value(known, field->value);
+        }
         if (!known.unit.empty()) {
             metric.properties.push_back(Property{std::string(unit_property), DataType::string, known.unit});
         }
-        if (known.writable) metric.properties.push_back(Property{std::string(writable_property), DataType::boolean, true});
+        if (known.writable) {
+            metric.properties.push_back(Property{std::string(writable_property), DataType::boolean, true});
+        }
         out.push_back(std::move(metric));
     }
     return out;
@@ -229,9 +229,9 @@ std::vector<Metric> MetricCatalogue::changed_metrics(std::string_view device, co
     if (it == devices_.end()) return out;
     const Device& known = it->second;
     for (const CatalogueMetric& entry : known.metrics) {
-        const engine::Field* after = find_field(now, entry.field);
+        const engine::Field* after = now.find(entry.field);
         if (after == nullptr) continue;
-        const engine::Field* before = find_field(published, entry.field);
+        const engine::Field* before = published.find(entry.field);
         if (before != nullptr && !mqtt::field_differs(*before, *after, known.deadband)) continue;
         Value value = metric_value(entry, after->value);
         // A list that moved: only the elements that did.

@@ -31,7 +31,9 @@ inline constexpr std::string_view writable_property = "writable";  ///< Boolean 
 /// What the catalogue needs of one device (part C fills it from mqtt::DeviceSource).
 struct DeviceShape {
     std::string name;                          ///< the device id (the configured name)
-    const core::PointModel* points = nullptr;  ///< its points, if any (DeviceSource::points())
+    /// Its points, if any (DeviceSource::points()); they must outlive the catalogue
+    /// (CatalogueMetric::point points into them).
+    const core::PointModel* points = nullptr;
     engine::DecodedState state;                ///< a decoded state: the built-in fields it has
     std::set<std::string, std::less<>> writable_fields;  ///< fields without a point that are writable
     /// Smallest change published per field (`mqtt.deadband`); a point's own deadband wins.

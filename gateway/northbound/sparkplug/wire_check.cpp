@@ -117,7 +117,9 @@ private:
         if (is_repeated) {
             const std::size_t count = ++repeated[field.id];
             std::size_t bound = limits_.max_repeated;
-            if (&descriptor == limits_.counted_message && field.id == limits_.counted_field) bound = limits_.counted_max;
+            if (&descriptor == limits_.counted_message && field.id == limits_.counted_field) {
+                bound = limits_.counted_max;
+            }
             if (&descriptor == limits_.narrow_message) bound = limits_.narrow_max;
             if (count > bound) {
                 return fail(tag_at, descriptor, &field, "more than the " + std::to_string(bound) + " elements allowed");

@@ -5,6 +5,7 @@
 #include "core/point.hpp"
 #include "northbound/mqtt/command_parser.hpp"
 #include "northbound/mqtt/point_commands.hpp"
+#include "point_def.hpp"
 
 namespace {
 
@@ -13,14 +14,7 @@ namespace fe = fieldbridge::engine;
 namespace fm = fieldbridge::northbound::mqtt;
 namespace fp = fieldbridge::protocol;
 
-core::PointDef point(std::string name, core::RegisterTable table, std::uint16_t address, core::PointType type) {
-    core::PointDef p;
-    p.name = std::move(name);
-    p.table = table;
-    p.address = address;
-    p.type = type;
-    return p;
-}
+using fieldbridge::test::point;
 
 /// A thermostat: float32 temperature (read-only), float32 setpoint 5..35 (writable),
 /// uint16 mode enum off/heat/cool (writable), a coil `enabled` (writable), a string name.

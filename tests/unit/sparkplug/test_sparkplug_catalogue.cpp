@@ -13,6 +13,7 @@
 #include "northbound/mqtt/payloads.hpp"
 #include "northbound/sparkplug/metric_catalogue.hpp"
 #include "northbound/upstream/r6_state.hpp"
+#include "point_def.hpp"
 
 namespace {
 
@@ -22,6 +23,7 @@ namespace sp = fieldbridge::northbound::sparkplug;
 namespace core = fieldbridge::core;
 using nlohmann::json;
 using T = sp::DataType;
+using fieldbridge::test::point;
 
 // Every register and bit of the four tables from 0 to 0x1FFF, with values that vary.
 void fill(fe::RegisterImage& image, std::uint16_t seed) {
@@ -108,15 +110,6 @@ void check_fields_match(const fm::SourceState& state, const core::PointModel* po
         CHECK(m.alias.has_value());
         CHECK(m.timestamp == 1000u);
     }
-}
-
-core::PointDef point(std::string name, core::RegisterTable table, std::uint16_t address, core::PointType type) {
-    core::PointDef p;
-    p.name = std::move(name);
-    p.table = table;
-    p.address = address;
-    p.type = type;
-    return p;
 }
 
 core::PointModel generic_points() {
