@@ -36,15 +36,17 @@ esac
 libraries=(
   libmodbus-dev libpaho-mqttpp-dev libpaho-mqtt-dev libssl-dev libyaml-cpp-dev
   libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
-  libcli11-dev libmicrohttpd-dev
+  libcli11-dev libmicrohttpd-dev libprotobuf-c-dev
 )
 packages=(
   # toolchain
   build-essential cmake ninja-build g++ pkg-config
   clang libclang-rt-14-dev  # the fuzz build (tests/fuzz): clang++ and its libFuzzer
+  protobuf-c-compiler  # protoc-c: the Sparkplug B schema's C code, generated at build time
   "${libraries[@]}"
   # test and demo tools
   socat mosquitto mosquitto-clients mbpoll curl python3 python3-pymodbus
+  protobuf-compiler python3-protobuf  # the tests' own Sparkplug B decoder (tests/support)
   prometheus  # promtool check metrics (tests/integration/gateway/test_metrics.py)
   python3-serial-asyncio procps  # pymodbus.client imports serial_asyncio (a Recommends)
   # Debian packages (deploy/build-deb) and their test (tests/package/test-package.sh):

@@ -55,7 +55,8 @@ install(FILES README.md docs/architecture.md docs/configuration.md docs/modbus-t
 install(FILES config/fieldbridge.example.yaml DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/fieldbridge/examples"
         COMPONENT daemon)
 # The shipped device definitions (docs/devices.md): the last of the default
-# `definitions:` directories, after the site's /etc/fieldbridge/devices.
+# `definitions:` directories, after the site's /etc/fieldbridge/devices. The built-in
+# types' files among them are also compiled into the binary (gateway/config/CMakeLists.txt).
 install(DIRECTORY config/devices/ DESTINATION "${CMAKE_INSTALL_DATADIR}/fieldbridge/devices" COMPONENT daemon
         FILES_MATCHING PATTERN "*.yaml")
 

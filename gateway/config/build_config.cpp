@@ -94,10 +94,14 @@ void set(T& target, const Field<T>& field) {
     if (raw.stroke.has_value()) {
         device.stroke = static_cast<std::uint32_t>(*raw.stroke);
     }
+    const RawDefinition* definition = raw.definition.get();
     if (device.type != DeviceType::modbus) {
+        if (definition != nullptr) {  // a file replaces the compiled-in definition
+            device.definition_file = definition->file;
+            device.registers = build_registers(*definition);
+        }
         return device;
     }
-    const RawDefinition* definition = raw.definition.get();
     const PointDefaults defaults = point_defaults(definition, &raw);
     device.word_order = defaults.word_order;
     device.period = defaults.period;

@@ -112,6 +112,30 @@ RegisterBlock build_block(const RawBlock& raw, milliseconds default_period) {
     return block;
 }
 
+std::vector<core::RegisterDef> build_registers(const RawDefinition& raw) {
+    std::vector<core::RegisterDef> rows;
+    for (const RawRegister& row : raw.registers.items) {
+        core::RegisterDef d;
+        d.table = row.table.value_or(RegisterTable::holding);
+        d.address = static_cast<std::uint16_t>(*row.address);
+        d.width = static_cast<std::uint8_t>(row.width.value_or(1));
+        d.count = static_cast<std::uint16_t>(row.count.value_or(1));
+        d.access = *row.access;
+        d.min = row.min.value_or(0);
+        d.max = row.max.value_or(d.width == 2 ? 0xFFFF'FFFF : (core::is_bit_table(d.table) ? 1 : 0xFFFF));
+        d.is_signed = d.min < 0;
+        d.name = *row.name;
+        d.motion = row.motion.value_or(false);
+        d.protect = row.protect.value_or(false);
+        d.auto_reset = row.auto_reset.value_or(false);
+        if (row.stop.has_value()) {
+            d.stop_value = static_cast<std::uint16_t>(*row.stop);
+        }
+        rows.push_back(std::move(d));
+    }
+    return rows;
+}
+
 DeviceDefinition build_definition(const RawDefinition& raw) {
     const PointDefaults defaults = point_defaults(&raw, nullptr);
     DeviceDefinition definition;
@@ -134,6 +158,10 @@ DeviceDefinition build_definition(const RawDefinition& raw) {
         }
         definition.identify = identify;
     }
+    if (raw.behaviour.has_value()) {
+        definition.behaviour = *raw.behaviour;
+    }
+    definition.registers = build_registers(raw);
     return definition;
 }
 

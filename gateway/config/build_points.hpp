@@ -30,5 +30,7 @@ struct PointDefaults {
 
 /// A valid raw definition with its defaults applied.
 [[nodiscard]] DeviceDefinition build_definition(const RawDefinition& raw);
+/// A valid definition's `registers:` with their defaults (docs/devices.md).
+[[nodiscard]] std::vector<core::RegisterDef> build_registers(const RawDefinition& raw);
 
 }  // namespace fieldbridge::config

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "config/net_address.hpp"
+#include "core/register_def.hpp"
 #include "core/device_type.hpp"
 #include "core/log_level.hpp"
 #include "core/modbus_ids.hpp"
@@ -198,12 +199,17 @@ struct DeviceConfig {
     static constexpr Range<std::int64_t> stroke_range{1, 0x7FFF'FFFF};
     std::vector<RegisterBlock> blocks;          ///< modbus only, required there
     /// `type:` as written: a built-in type's name, or a device definition's name
-    /// (then `type` is DeviceType::modbus and `definition_file` says where it came from).
+    /// (then `type` is DeviceType::modbus, or the definition's behaviour, and
+    /// `definition_file` says where it came from).
     std::string type_name;
-    std::string definition_file;                ///< "" for built-in types
+    std::string definition_file;                ///< "" for generic devices without one and built-ins compiled in
     /// Points and alarms (the definition's, then the inline ones) and `max_gap`;
     /// empty for the built-in types.
     core::PointModel points;
+    /// Built-in types: the register map of the definition file that replaces the
+    /// compiled-in one (docs/devices.md, "Built-in types"); empty when the compiled-in
+    /// definition is used, and for generic devices.
+    std::vector<core::RegisterDef> registers;
     /// Generic devices: the poll period of points (and blocks) that set none.
     milliseconds period = seconds{1};
     /// Registers (bits) no point names that one merged read may bridge.

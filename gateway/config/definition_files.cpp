@@ -55,6 +55,55 @@ struct Lookup {
     std::string file;                                 ///< "" when not found
 };
 
+using Lookups = std::map<std::string, Lookup, std::less<>>;
+
+/// The definition @p name in @p dirs, read once per name (its problems reported once).
+Lookups::const_iterator look_up(const std::string& name, const std::vector<std::filesystem::path>& dirs,
+                                Lookups& read, DiagnosticSink& sink) {
+    auto it = read.find(name);
+    if (it == read.end()) {
+        Lookup lookup;
+        if (const auto file = find_definition(name, dirs)) {
+            std::vector<Diagnostic> problems;
+            lookup.file = std::filesystem::absolute(*file).lexically_normal().string();
+            lookup.definition = read_definition(lookup.file, problems);
+            for (auto& problem : problems) {
+                sink.add(std::move(problem));
+            }
+        }
+        it = read.emplace(name, std::move(lookup)).first;
+    }
+    return it;
+}
+
+/// A built-in type's definition file in @p dirs replaces the compiled-in one
+/// (docs/devices.md, "Built-in types"); without one the device keeps no definition
+/// and the engine uses the compiled-in copy.
+void resolve_builtin(RawDevice& device, const std::vector<std::filesystem::path>& dirs, Lookups& read,
+                     DiagnosticSink& sink) {
+    const std::string& name = *device.type_name;
+    const auto it = look_up(name, dirs, read, sink);
+    if (it->second.file.empty()) {
+        return;
+    }
+    const auto& definition = it->second.definition;
+    if (definition == nullptr) {
+        sink.error(device.type_name, "the device definition " + it->second.file + " replaces the built-in " + name +
+                                         " and has problems (listed under its name); fix them, or remove the file "
+                                         "to use the definition built into fieldbridge");
+        device.type.invalid = true;
+        device.type.value.reset();
+    } else if (definition->behaviour.value_or(DeviceType::modbus) != *device.type) {
+        sink.error(device.type_name, "the device definition " + it->second.file + " replaces the built-in " + name +
+                                         " but does not name its behaviour; expected behaviour: " + name +
+                                         " in it (or remove the file to use the definition built into fieldbridge)");
+        device.type.invalid = true;
+        device.type.value.reset();
+    } else {
+        device.definition = definition;
+    }
+}
+
 }  // namespace
 
 std::vector<std::filesystem::path> definition_dirs(const RawConfig& raw, const std::filesystem::path& base_dir) {
@@ -85,46 +134,55 @@ std::optional<std::filesystem::path> find_definition(std::string_view name,
     return std::nullopt;
 }
 
-std::shared_ptr<const RawDefinition> read_definition(const std::filesystem::path& file,
-                                                     std::vector<Diagnostic>& problems) {
-    DiagnosticSink sink(file.string());
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(file, ec);
-    std::ifstream in(file, std::ios::binary);
-    if (ec || !in) {
-        sink.error(Mark{}, "", "cannot read the device definition file; check that it exists and that the service "
-                               "user may read it");
-    } else if (size > max_definition_bytes) {
-        sink.error(Mark{}, "", "the file is " + std::to_string(size) + " bytes; a device definition is at most " +
-                                   std::to_string(max_definition_bytes) + " bytes: is it the right file?");
-    } else {
-        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        YamlDocuments documents;
-        try {
-            documents = read_documents(text);
-        } catch (const YAML::Exception& e) {
-            sink.error(to_mark(e.mark, Mark{1, 1}), "", "YAML syntax error: " + e.msg + "; fix the YAML at this position");
+std::shared_ptr<const RawDefinition> parse_definition_text(std::string_view text, const std::string& file,
+                                                           std::string_view stem, std::vector<Diagnostic>& problems) {
+    DiagnosticSink sink(file);
+    YamlDocuments documents;
+    try {
+        documents = read_documents(std::string(text));
+    } catch (const YAML::Exception& e) {
+        sink.error(to_mark(e.mark, Mark{1, 1}), "", "YAML syntax error: " + e.msg + "; fix the YAML at this position");
+    }
+    if (sink.empty() && (!documents.first || documents.first.IsNull())) {
+        sink.error(Mark{1, 1}, "", "the device definition is empty; expected at least name: and points:");
+    } else if (sink.empty()) {
+        if (documents.second) {
+            sink.error(to_mark(*documents.second, Mark{1, 1}), "",
+                       "a second YAML document starts here (---); expected a single document");
         }
-        if (sink.empty() && (!documents.first || documents.first.IsNull())) {
-            sink.error(Mark{1, 1}, "", "the device definition is empty; expected at least name: and points:");
-        } else if (sink.empty()) {
-            if (documents.second) {
-                sink.error(to_mark(*documents.second, Mark{1, 1}), "",
-                           "a second YAML document starts here (---); expected a single document");
-            }
-            auto definition = std::make_shared<RawDefinition>(parse_definition(documents.first, file.string(), sink));
-            if (definition->ok()) {
-                validate_definition(*definition, file.stem().string(), sink);
-            }
-            if (sink.empty()) {
-                return definition;
-            }
+        auto definition = std::make_shared<RawDefinition>(parse_definition(documents.first, file, sink));
+        if (definition->ok()) {
+            validate_definition(*definition, stem, sink);
+        }
+        if (sink.empty()) {
+            return definition;
         }
     }
     for (auto& d : sink.take_sorted()) {
         problems.push_back(std::move(d));
     }
     return nullptr;
+}
+
+std::shared_ptr<const RawDefinition> read_definition(const std::filesystem::path& file,
+                                                     std::vector<Diagnostic>& problems) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(file, ec);
+    std::ifstream in(file, std::ios::binary);
+    if (ec || !in) {
+        problems.push_back(Diagnostic{file.string(), 0, 0, "",
+                                      "cannot read the device definition file; check that it exists and that the "
+                                      "service user may read it"});
+        return nullptr;
+    }
+    if (size > max_definition_bytes) {
+        problems.push_back(Diagnostic{file.string(), 0, 0, "",
+                                      "the file is " + std::to_string(size) + " bytes; a device definition is at most " +
+                                          std::to_string(max_definition_bytes) + " bytes: is it the right file?"});
+        return nullptr;
+    }
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return parse_definition_text(text, file.string(), file.stem().string(), problems);
 }
 
 void resolve_definitions(RawConfig& raw, const std::filesystem::path& base_dir, DiagnosticSink& sink) {
@@ -134,10 +192,16 @@ void resolve_definitions(RawConfig& raw, const std::filesystem::path& base_dir, 
         }
     }
     const auto dirs = definition_dirs(raw, base_dir);
-    std::map<std::string, Lookup, std::less<>> read;
+    Lookups read;
     for (auto& line : raw.lines.items) {
         for (auto& device : line.devices.items) {
-            if (!device.ok() || !device.type_name.has_value() || device.type.has_value()) {
+            if (!device.ok() || !device.type_name.has_value()) {
+                continue;
+            }
+            if (device.type.has_value()) {
+                if (*device.type != DeviceType::modbus) {
+                    resolve_builtin(device, dirs, read, sink);
+                }
                 continue;
             }
             const std::string& name = *device.type_name;
@@ -149,19 +213,7 @@ void resolve_definitions(RawConfig& raw, const std::filesystem::path& base_dir, 
                                                  "letter or digit, up to 64 characters)");
                 continue;
             }
-            auto it = read.find(name);
-            if (it == read.end()) {
-                Lookup lookup;
-                if (const auto file = find_definition(name, dirs)) {
-                    std::vector<Diagnostic> problems;
-                    lookup.file = std::filesystem::absolute(*file).lexically_normal().string();
-                    lookup.definition = read_definition(lookup.file, problems);
-                    for (auto& problem : problems) {
-                        sink.add(std::move(problem));
-                    }
-                }
-                it = read.emplace(name, std::move(lookup)).first;
-            }
+            const auto it = look_up(name, dirs, read, sink);
             if (it->second.file.empty()) {
                 sink.error(device.type_name, "'" + name + "' is not a built-in type" + built_in_hint(name) + " (" +
                                                  built_in_names() +
@@ -174,7 +226,8 @@ void resolve_definitions(RawConfig& raw, const std::filesystem::path& base_dir, 
                                                  " has problems (listed under its name); fix them");
             } else {
                 device.definition = it->second.definition;
-                device.type.value = DeviceType::modbus;
+                // A site's variant of a built-in type (behaviour:) is that type.
+                device.type.value = it->second.definition->behaviour.value_or(DeviceType::modbus);
                 device.type.invalid = false;
             }
         }

@@ -16,6 +16,7 @@
 #include "config/config.hpp"
 #include "config/diagnostic.hpp"
 #include "core/point.hpp"
+#include "core/register_def.hpp"
 
 namespace fieldbridge::config {
 
@@ -29,6 +30,10 @@ struct DeviceDefinition {
     core::PointModel points;  ///< points with their defaults, alarms, max_gap
     std::vector<RegisterBlock> blocks;
     std::optional<core::IdentifyRead> identify;
+    /// A built-in type's hook (`behaviour:`) and its register map (`registers:`);
+    /// nullopt and empty for a generic device.
+    std::optional<DeviceType> behaviour;
+    std::vector<core::RegisterDef> registers;
     bool operator==(const DeviceDefinition&) const = default;
 };
 

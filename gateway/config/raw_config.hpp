@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "config/config.hpp"
+#include "core/register_def.hpp"
 
 namespace fieldbridge::config {
 
@@ -163,6 +164,22 @@ struct RawIdentify : RawNode {
     FieldList<std::int64_t> expect;
 };
 
+/// One row of a built-in type's `registers:` (core/register_def.hpp).
+struct RawRegister : RawNode {
+    Field<std::string> name;
+    Field<RegisterTable> table;
+    Field<std::int64_t> address;
+    Field<std::int64_t> width;
+    Field<std::int64_t> count;
+    Field<core::Access> access;
+    Field<std::int64_t> min;
+    Field<std::int64_t> max;
+    Field<bool> motion;
+    Field<bool> protect;  ///< `protected:`
+    Field<bool> auto_reset;
+    Field<std::int64_t> stop;
+};
+
 /// A device definition file (`<dir>/<name>.yaml`), as written. Its positions are
 /// in `file`, not in the configuration.
 struct RawDefinition : RawNode {
@@ -176,6 +193,8 @@ struct RawDefinition : RawNode {
     RawSeq<RawAlarm> alarms;
     RawSeq<RawBlock> blocks;
     RawIdentify identify;
+    Field<DeviceType> behaviour;     ///< the C++ hook of a built-in type
+    RawSeq<RawRegister> registers;   ///< with `behaviour:` only
 };
 
 struct RawDevice : RawNode {

@@ -90,6 +90,28 @@ RawIdentify parse_identify(const NodeRef& ref, DiagnosticSink& sink) {
     return raw;
 }
 
+RawRegister parse_register(const NodeRef& ref, DiagnosticSink& sink) {
+    const MapReader map(ref,
+                        {"name", "table", "address", "width", "count", "access", "min", "max", "motion", "protected",
+                         "auto_reset", "stop"},
+                        sink);
+    RawRegister raw;
+    map.fill(raw);
+    raw.name = read_string(map, "name");
+    raw.table = read_enum(map, "table", core::register_table_names);
+    raw.address = read_int(map, "address");
+    raw.width = read_int(map, "width");
+    raw.count = read_int(map, "count");
+    raw.access = read_enum(map, "access", core::access_names);
+    raw.min = read_int(map, "min");
+    raw.max = read_int(map, "max");
+    raw.motion = read_bool(map, "motion");
+    raw.protect = read_bool(map, "protected");
+    raw.auto_reset = read_bool(map, "auto_reset");
+    raw.stop = read_int(map, "stop");
+    return raw;
+}
+
 }  // namespace
 
 RawSeq<RawPoint> parse_points(const MapReader& map, std::string_view key) {
@@ -104,7 +126,7 @@ RawDefinition parse_definition(const YAML::Node& root, std::string file, Diagnos
     const NodeRef root_ref{root, "", to_mark(root.Mark(), Mark{1, 1})};
     const MapReader map(root_ref,
                         {"name", "description", "word_order", "period", "max_gap", "points", "alarms", "blocks",
-                         "identify"},
+                         "identify", "behaviour", "registers"},
                         sink, true);
     RawDefinition raw;
     map.fill(raw);
@@ -118,6 +140,8 @@ RawDefinition parse_definition(const YAML::Node& root, std::string file, Diagnos
     raw.alarms = parse_alarms(map, "alarms");
     raw.blocks = read_seq<RawBlock>(map, "blocks", parse_block);
     raw.identify = parse_identify(map.child("identify"), sink);
+    raw.behaviour = read_enum(map, "behaviour", core::behaviour_names);
+    raw.registers = read_seq<RawRegister>(map, "registers", parse_register);
     return raw;
 }
 

@@ -172,6 +172,11 @@ void check_blocks(const RawSeq<RawBlock>& blocks, const RawSeq<RawBlock>* earlie
 /// read; @p stem is its file name without `.yaml` (validate_definition.cpp).
 void validate_definition(const RawDefinition& definition, std::string_view stem, DiagnosticSink& sink);
 
+/// `registers:` and the keys that go with `behaviour:` (validate_registers.cpp): a
+/// definition with a hook has rows of registers and no points, alarms, blocks,
+/// identify, word_order, period or max_gap; one without has no registers.
+void check_registers(const RawDefinition& definition, DiagnosticSink& sink);
+
 /// A number as written in messages: 21.5, 1e+06.
 [[nodiscard]] std::string format_number(double value);
 

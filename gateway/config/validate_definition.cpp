@@ -63,6 +63,10 @@ void validate_definition(const RawDefinition& definition, std::string_view stem,
     (void)check_alarms(definition.alarms, points, {}, sink);
     check_blocks(definition.blocks, nullptr, sink);
     check_identify(definition.identify, sink);
+    check_registers(definition, sink);
+    if (definition.behaviour.has_value() || definition.behaviour.invalid) {
+        return;  // a built-in type: registers, not points (check_registers())
+    }
     const bool has_points = definition.points.ok() && !definition.points.items.empty();
     const bool has_blocks = definition.blocks.ok() && !definition.blocks.items.empty();
     if (!has_points && !has_blocks && definition.points.state != RawNode::State::invalid &&

@@ -164,7 +164,8 @@ void check_type_specific(const RawDevice& device, DiagnosticSink& sink) {
     } else {
         if (!device.blocks.absent()) {
             sink.error(device.blocks, "blocks apply only to generic modbus devices" + of_type +
-                                          "; the register map of this type is built in");
+                                          "; the register map of this type is its definition file (docs/devices.md, "
+                                          "\"Built-in types\")");
         }
         const std::string generic_only = " apply only to generic modbus devices and device definitions" + of_type +
                                          "; remove them";

@@ -26,4 +26,14 @@ struct Names<DeviceType> {
     static constexpr const auto& table = device_type_names;
 };
 
+/// The behaviour hooks a device definition may name (`behaviour:`, docs/devices.md,
+/// "Built-in types"): the built-in types, whose C++ (engine/profiles/profile_factory.cpp)
+/// holds what is not data. `modbus` is no hook: a definition without one is generic.
+inline constexpr NameTable<DeviceType, 4> behaviour_names{{
+    {"hiwin-xeg", DeviceType::hiwin_xeg},
+    {"excd203mb", DeviceType::excd203mb},
+    {"wtec-rtu", DeviceType::wtec_rtu},
+    {"wtec-ascii", DeviceType::wtec_ascii},
+}};
+
 }  // namespace fieldbridge::core

@@ -1,5 +1,5 @@
 # Register image, point codec (points/) and device profiles (XEG, EXCD203MB, WTEC RTU, WTEC ASCII view,
-# generic Modbus). Pure logic over the protocol codecs: no I/O, no clock.
+# generic Modbus). Pure logic over the protocol codecs and the built-in types' definitions: no I/O, no clock.
 add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/register_image.cpp
   ${CMAKE_CURRENT_LIST_DIR}/points/point_codec.cpp
@@ -10,6 +10,7 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/register_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/modbus_profile.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/builtin_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/xeg_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/excd_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_common.cpp
@@ -21,4 +22,5 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/profiles/profile_factory.cpp
 )
 target_include_directories(fb_engine_devices PUBLIC ${PROJECT_SOURCE_DIR}/gateway)
-target_link_libraries(fb_engine_devices PUBLIC fb_protocol PRIVATE fb_build_options)
+# fb_config: the built-in types' compiled-in definitions (config/builtin_definitions.hpp).
+target_link_libraries(fb_engine_devices PUBLIC fb_protocol fb_config PRIVATE fb_build_options)

@@ -86,6 +86,7 @@ ProfileOptions profile_options(const config::DeviceConfig& device) {
                                               block.writable});
     }
     options.points = device.points;
+    options.registers = device.registers;
     return options;
 }
 

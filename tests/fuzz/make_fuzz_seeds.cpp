@@ -4,7 +4,9 @@
 //   reply framer, the PDU codec and the WTEC ASCII scanner;
 // - from the example configurations (config/*.yaml): the config loader;
 // - from tests/fuzz/mqtt_commands.txt (the examples of docs/mqtt.md): the MQTT
-//   command parser.
+//   command parser;
+// - built here with the codec: a few Sparkplug B commands, for the Sparkplug command
+//   decoder.
 // Usage: make_fuzz_seeds <output directory>; one subdirectory per harness.
 
 #include <cstdint>
@@ -16,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "northbound/sparkplug/command_decoder.hpp"
+#include "northbound/sparkplug/payload_codec.hpp"
 #include "protocol/mbap_frame.hpp"
 #include "protocol/wtec_ascii_commands.hpp"
 #include "protocol/wtec_ascii_frame.hpp"
@@ -134,6 +138,27 @@ void mqtt_seeds(const fs::path& commands_file, const fs::path& out) {
     std::cout << "make_fuzz_seeds: " << parser.count() << " MQTT command seeds\n";
 }
 
+/// A few commands a Sparkplug host sends (docs/sparkplug.md, "Commands"): a rebirth
+/// request, writes by alias with and without datatype, by name, several at once.
+void sparkplug_seeds(const fs::path& out) {
+    namespace sp = fieldbridge::northbound::sparkplug;
+    SeedWriter commands(out / "fuzz_sparkplug_command");
+    const auto write = [&](std::vector<sp::CommandMetric> metrics) {
+        const std::string bytes = sp::encode(sp::command_payload(sp::Command{1700000000000, std::move(metrics)}));
+        commands.write(text_bytes(bytes));
+    };
+    using T = sp::DataType;
+    write({{{"Node Control/Rebirth", std::nullopt}, T::boolean, true}});
+    write({{{std::nullopt, 4}, T::uint16, std::uint64_t{80}}});
+    write({{{std::nullopt, 4}, std::nullopt, std::uint64_t{80}}});
+    write({{{"force_pct", std::nullopt}, T::int16, static_cast<std::uint64_t>(-5)}});
+    write({{{"setpoint", 9}, T::float32, 12.5f},
+           {{"ratio", std::nullopt}, T::float64, 0.25},
+           {{"label", std::nullopt}, T::string, std::string("tool 2")},
+           {{std::nullopt, 11}, T::int64, static_cast<std::uint64_t>(-1)}});
+    std::cout << "make_fuzz_seeds: " << commands.count() << " Sparkplug command seeds\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -148,6 +173,7 @@ int main(int argc, char** argv) {
         wtec_seeds(vectors, out);
         config_seeds(fs::path(FIELDBRIDGE_SOURCE_DIR) / "config", out);
         mqtt_seeds(fs::path(FIELDBRIDGE_SOURCE_DIR) / "tests/fuzz/mqtt_commands.txt", out);
+        sparkplug_seeds(out);
     } catch (const std::exception& error) {
         std::cerr << "make_fuzz_seeds: " << error.what() << "\n";
         return 1;

@@ -178,6 +178,10 @@ check "fieldbridge --check-config /etc/fieldbridge/fieldbridge.yaml (as user fie
 check "fieldbridge-sim --help" /usr/bin/fieldbridge-sim --help
 check "installed: the shipped device definitions in /usr/share/fieldbridge/devices" \
   test -f /usr/share/fieldbridge/devices/example-thermostat.yaml
+for builtin in hiwin-xeg excd203mb wtec-rtu wtec-ascii; do
+  check "installed: the built-in type's definition $builtin.yaml in /usr/share/fieldbridge/devices, as shipped" \
+    cmp "/usr/share/fieldbridge/devices/$builtin.yaml" "$here/config/devices/$builtin.yaml"
+done
 check "docs: the definition guide devices.md in /usr/share/doc/fieldbridge" \
   contains "$(dpkg -L fieldbridge)" '^/usr/share/doc/fieldbridge/devices\.md'
 # A device of a shipped definition, with no definitions: key: found in the default

@@ -25,6 +25,7 @@
 #include "core/error.hpp"
 #include "core/modbus_ids.hpp"
 #include "core/point.hpp"
+#include "core/register_def.hpp"
 #include "core/word_order.hpp"
 #include "engine/profiles/operations.hpp"
 #include "engine/profiles/poll_plan.hpp"
@@ -71,6 +72,9 @@ struct ProfileOptions {
     std::optional<std::uint32_t> wtec_stroke;      ///< wtec-ascii: encoder counts for 100 %; required
     std::vector<GenericBlock> blocks;              ///< modbus: raw blocks (with points: optional)
     core::PointModel points;                       ///< modbus: named, typed points and their alarms
+    /// Built-in types: the register map of a definition file that replaced the
+    /// compiled-in one; empty: the compiled-in definition's (builtin_map.hpp).
+    std::vector<core::RegisterDef> registers;
 };
 
 /// Options a profile cannot work with; what() names the option and the fix.

@@ -1,10 +1,10 @@
 #include "engine/profiles/excd_profile.hpp"
 
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "engine/profiles/builtin_map.hpp"
 #include "engine/profiles/profile_text.hpp"
 
 namespace fieldbridge::engine {
@@ -33,128 +33,6 @@ constexpr std::uint16_t sensor = 0x0206;
 constexpr std::uint16_t ver = 0x0207;
 constexpr std::uint16_t renc = 0x02D4;
 constexpr std::uint16_t ralarm = 0x02D6;
-
-/// A single register (width 1) or a pair (width 2) of the holding table.
-[[nodiscard]] RegisterDef reg(std::uint16_t address, std::string name, std::uint8_t width, Access access,
-                              std::int64_t min, std::int64_t max, std::uint16_t count = 1) {
-    RegisterDef d;
-    d.table = Table::holding;
-    d.address = address;
-    d.width = width;
-    d.count = count;
-    d.access = access;
-    d.min = min;
-    d.max = max;
-    d.is_signed = min < 0;
-    d.name = std::move(name);
-    return d;
-}
-
-[[nodiscard]] RegisterDef system(std::uint16_t address, std::string name, std::int64_t min, std::int64_t max,
-                                 std::uint8_t width = 1) {
-    return reg(address, std::move(name), width, Access::read_write, min, max);
-}
-
-[[nodiscard]] RegisterDef flagged(RegisterDef d, bool motion, bool protect, std::optional<std::uint16_t> stop = {}) {
-    d.motion = motion;
-    d.protect = protect;
-    d.stop_value = stop;
-    return d;
-}
-
-[[nodiscard]] std::shared_ptr<const RegisterMap> excd_register_map() {
-    constexpr auto rw = Access::read_write;
-    constexpr auto w = Access::write;
-    constexpr auto r = Access::read;
-    std::vector<RegisterDef> defs{
-        // System parameters 0x0000-0x0031 (all models).
-        system(0x0000, "hdir", 0, 1),
-        system(0x0001, "hvs", 1, 0x1388),
-        system(0x0002, "htr", 1, 0x927C0, 2),
-        system(0x0004, "hvr", 1, 0x7A120, 2),
-        system(0x0006, "hsd", 1, 0xFA),
-        system(0x0007, "jvs", 1, 0x1388),
-        system(0x0008, "jtr", 1, 0x927C0, 2),
-        system(0x000A, "jvr", 1, 0x7A120, 2),
-        system(0x000C, "svs", 1, 0x1388),
-        system(0x000D, "str", 1, 0x927C0, 2),
-        system(0x000F, "svr", 1, 0x7A120, 2),
-        system(0x0011, "div", 0xC8, 0xC800),
-        system(0x0012, "cur", 0x0A, 0x1E),
-        system(0x0013, "solmsw", 0, 2),
-        system(0x0014, "solm+", position_min, position_max, 2),
-        system(0x0016, "solm-", position_min, position_max, 2),
-        system(0x0018, "hty", 0, 1),
-        system(0x0019, "lty+", 0, 1),
-        system(0x001A, "lty-", 0, 1),
-        system(0x001B, "sty", 0, 1),
-        system(0x001C, "oclr", 0, 1),
-        system(0x001D, "auto", 0, 1),
-        system(0x001E, "hold", 0, 1),
-        flagged(system(0x001F, "idon", 0, 1), false, true),
-        flagged(system(0x0020, "id", 0, 0x3F), false, true),
-        system(0x0021, "pulse", 0, 1),
-        system(0x0022, "pitch", 1, 0x1869F, 2),
-        system(0x0024, "hfset", position_min, position_max, 2),
-        system(0x0026, "curdwn", 0, 0x64),
-        system(0x0027, "extvr", 0, 1),
-        system(0x0028, "htime", 5, 0x64),
-        system(0x0029, "intime", 5, 0x64),
-        system(0x002A, "stime", 5, 0x64),
-        flagged(system(0x002B, "baude", 0x4B0, 0x1C200, 2), false, true),
-        system(0x002D, "hmode", 0, 1),
-        system(0x002E, "hloop", 1, 0xFA),
-        system(0x002F, "ifinbit", 0, 1),
-        system(0x0030, "curdwnt", 0x64, 0x36EE80, 2),
-        // 0x0032-0x003C: EXCD203MB-E only; a plain EXCD203MB answers 0x02 itself.
-        system(0x0032, "mdir", 0, 1),
-        system(0x0033, "clr", 0, 0),
-        system(0x0034, "encdiv", 0, 0),
-        system(0x0035, "enc", 0, 2),
-        system(0x0036, "homez", 0, 0x64),
-        system(0x0037, "edir", 0, 1),
-        system(0x0038, "zty", 0, 1),
-        system(0x0039, "curm", 5, 0x1E),
-        // mbus switches the controller out of Modbus mode: protected like a baud change.
-        flagged(system(0x003A, "mbus", 0, 1), false, true),
-        system(0x003B, "make", 1, 0x32),
-        system(0x003C, "prr", 0, 0xFF),
-        // Motion commands 0x0100-0x010C ("運轉指令"): write-only.
-        flagged(reg(excd_abs, "abs", 2, w, position_min, position_max), true, false),
-        flagged(reg(0x0102, "sabs", 2, w, position_min, position_max), true, false),
-        flagged(reg(excd_rel, "rel", 2, w, position_min, position_max), true, false),
-        flagged(reg(0x0106, "start", 1, w, 0, 0), true, false),
-        flagged(reg(excd_home, "home", 1, w, 0, 0), true, false),
-        flagged(reg(excd_stop, "stop", 1, w, 0, 0), true, false, 0),
-        flagged(reg(excd_mstop, "mstop", 1, w, 0, 0), true, false, 0),
-        flagged(reg(jog, "jog", 2, w, position_min, position_max), true, false),
-        flagged(reg(excd_jog_stop, "jog stop", 1, w, 0, 0), true, false, 0),
-        // Queries 0x0200-0x020A ("查詢指令"): read-only.
-        reg(0x0200, "rms", 1, r, 0, 0xFFFF),
-        reg(rabs, "rabs", 2, r, position_min, position_max),
-        reg(rin, "rin", 1, r, 0, 0xFFFF),
-        reg(rout, "rout", 1, r, 0, 0xFFFF),
-        reg(rby, "rby", 1, r, 0, 1),
-        reg(sensor, "sensor", 1, r, 0, 0xFFFF),
-        reg(ver, "ver", 2, r, 0, 0xFFFF'FFFF),
-        reg(0x0209, "rse", 1, r, 0, 0xFFFF),
-        reg(0x020A, "rsa", 1, r, 0, 0xFFFF),
-        // Counters: rcount1-50 read, cnt1-50 written ("cnt寫入指令").
-        reg(0x020C, "rcount", 2, r, 0, 0xFFFF'FFFF, 50),
-        reg(0x0270, "cnt", 2, w, position_min, position_max, 50),
-        reg(renc, "renc", 2, r, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()),
-        reg(ralarm, "ralarm", 1, r, 0, 0xFFFF),
-        // I/O commands and save ("I/O指令", "其他指令").
-        reg(0x0300, "outon", 1, w, 0, 0xF),
-        reg(0x0301, "clear", 1, w, 0, 0),
-        reg(0x0302, "outoff", 1, w, 0, 0xF),
-        flagged(reg(0x0303, "save", 1, w, 0, 0), false, true),
-        // Variables n01-n99 and counter resets rstcount1-50.
-        reg(0x0401, "n", 2, rw, position_min, position_max, 99),
-        reg(0x04C7, "rstcount", 1, w, 0, 0, 50),
-    };
-    return std::make_shared<const RegisterMap>(std::move(defs));
-}
 
 [[nodiscard]] WireFunctions excd_wire_functions() {
     // Seed 002 §2: FC03, FC06, FC10 only.
@@ -212,7 +90,8 @@ IdentificationRead excd_identification() noexcept { return IdentificationRead{ve
 OperationSet excd_operations() { return OperationSet{"excd", excd_operation_table()}; }
 
 ExcdProfile::ExcdProfile(const ProfileOptions& options)
-    : ModbusProfile(excd_register_map(), excd_wire_functions(), options, options.word_order) {}
+    : ModbusProfile(builtin_register_map(DeviceType::excd203mb, options), excd_wire_functions(), options,
+                    options.word_order) {}
 
 std::optional<ExceptionCode> ExcdProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
                                                       std::int64_t value, const RegisterImage& /*image*/) const {

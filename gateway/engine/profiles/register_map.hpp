@@ -16,43 +16,20 @@
 #include <string>
 #include <vector>
 
+#include "core/register_def.hpp"
 #include "engine/profiles/poll_plan.hpp"
 #include "engine/register_image.hpp"
 #include "protocol/modbus_pdu.hpp"
 
 namespace fieldbridge::engine {
 
-enum class Access : std::uint8_t { read = 1, write = 2, read_write = 3 };
-
-[[nodiscard]] constexpr bool can_read(Access a) noexcept { return (static_cast<unsigned>(a) & 1U) != 0; }
-[[nodiscard]] constexpr bool can_write(Access a) noexcept { return (static_cast<unsigned>(a) & 2U) != 0; }
+using core::Access;
+using core::can_read;
+using core::can_write;
+using core::RegisterDef;
 
 /// The widest unit of a map: a point of a generic device read in one request.
 inline constexpr std::uint8_t max_unit_width = 125;
-
-/// One entry: @p count consecutive units of @p width registers each, all alike
-/// (EXCD's n01..n99 is one entry of 99 pairs). Northbound, a pair is always high
-/// word first (at the lower address). A unit wider than one register is written
-/// whole or not at all.
-struct RegisterDef {
-    Table table = Table::holding;
-    std::uint16_t address = 0;
-    std::uint8_t width = 1;   ///< 1; 2 for a 32-bit pair; up to 125 for a generic device's point
-    std::uint16_t count = 1;  ///< units in this entry
-    Access access = Access::read_write;
-    bool is_signed = false;   ///< pairs: two's complement 32-bit
-    std::int64_t min = 0;     ///< allowed values for writes (both ends included)
-    std::int64_t max = 0xFFFF;
-    std::string name;         ///< the manual's name; entries with count > 1: a prefix
-    bool motion = false;      ///< writing it moves (or stops) the device: rule 5
-    bool protect = false;     ///< refused with 0x01 unless allow_protected (spec §4)
-    bool auto_reset = false;  ///< the device resets it to 0 after acting (XEG §3.4)
-    std::optional<std::uint16_t> stop_value;  ///< writing this value is a stop (rule 4)
-
-    [[nodiscard]] std::size_t end() const noexcept {
-        return std::size_t{address} + std::size_t{width} * count;
-    }
-};
 
 /// One unit of a request: the entry it belongs to and its first address.
 struct UnitRef {

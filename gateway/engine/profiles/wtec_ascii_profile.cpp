@@ -7,6 +7,7 @@
 #include <utility>
 #include <variant>
 
+#include "engine/profiles/builtin_map.hpp"
 #include "engine/profiles/wtec_ascii_image.hpp"
 #include "protocol/gateway_exceptions.hpp"
 #include "engine/profiles/wtec_common.hpp"
@@ -75,43 +76,6 @@ void sources_of(Table table, std::uint16_t address, std::array<bool, src_count>&
     } else {
         need[src_A] = true;
     }
-}
-
-[[nodiscard]] RegisterDef ext(std::uint16_t address, std::string name, std::uint8_t width = 1,
-                              std::uint16_t count = 1) {
-    RegisterDef d;
-    d.table = Table::input;
-    d.address = address;
-    d.width = width;
-    d.count = count;
-    d.access = Access::read;
-    d.name = std::move(name);
-    return d;
-}
-
-[[nodiscard]] std::vector<RegisterDef> view_defs() {
-    std::vector<RegisterDef> defs = wtec_uniform_defs(true);
-    const std::vector<RegisterDef> extension{
-        ext(ext_position, "I position", 2),     ext(ext_current, "I current"),
-        ext(ext_enabled, "I enable"),           ext(ext_grip_code, "grip state code"),
-        ext(ext_homing_code, "homing state code"),
-        ext(ext_n_target, "N target", 2),       ext(ext_n_current, "N max current"),
-        ext(ext_n_speed, "N speed"),            ext(ext_n_confirm, "N confirm time"),
-        ext(ext_n_home_at_power_up, "N home at power-up"),
-        ext(ext_r_max_speed, "R max speed", 2), ext(ext_r_max_accel, "R max acceleration", 2),
-        ext(ext_r_max_current, "R max current"), ext(ext_r_damping, "R damping"),
-        ext(ext_r_program, "R program"),        ext(ext_r_mode, "R mode"),
-        ext(ext_r_pulses, "R pulses per revolution"), ext(ext_r_ferror, "R following error", 2),
-        ext(ext_r_multi_turn, "R multi-turn"),  ext(ext_b_mode, "B mode"),
-        ext(ext_b_speed, "B speed", 2),         ext(ext_b_accel, "B acceleration", 2),
-        ext(ext_b_offset, "B offset", 2),       ext(ext_b_current, "B current"),
-        ext(ext_b_sensor, "B sensor mode"),     ext(ext_b_confirm, "B confirm time", 2),
-        ext(ext_b_max_distance, "B max distance", 2),
-        ext(ext_pid, "PID", 1, 3),              ext(ext_release, "W release", 1, 2),
-        ext(ext_firmware, "A firmware", 1, ext_firmware_registers),
-    };
-    defs.insert(defs.end(), extension.begin(), extension.end());
-    return defs;
 }
 
 [[nodiscard]] const std::array<core::FunctionCode, 4>& view_functions() {
@@ -186,7 +150,8 @@ std::uint16_t wtec_uniform_init_state(std::uint8_t code) noexcept {
     return code == wtec::homing_state::beyond_limit ? init_failed : code;
 }
 
-WtecAsciiProfile::WtecAsciiProfile(const ProfileOptions& options) : map_(view_defs()), options_(options) {
+WtecAsciiProfile::WtecAsciiProfile(const ProfileOptions& options)
+    : map_(*builtin_register_map(DeviceType::wtec_ascii, options)), options_(options) {
     if (!options.wtec_stroke || *options.wtec_stroke == 0) {
         throw ProfileError("wtec-ascii device: `stroke` (encoder counts from the homing point to 100 %) is "
                            "required and must be positive; read N's target at both ends to find it");

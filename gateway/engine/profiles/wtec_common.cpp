@@ -10,18 +10,6 @@ namespace fieldbridge::engine {
 
 namespace {
 
-[[nodiscard]] RegisterDef reg(std::uint16_t address, std::string name, Access access, std::int64_t min,
-                              std::int64_t max) {
-    RegisterDef d;
-    d.table = Table::holding;
-    d.address = address;
-    d.access = access;
-    d.min = min;
-    d.max = max;
-    d.name = std::move(name);
-    return d;
-}
-
 // ---- MQTT operations (docs/mqtt.md, "wtec-rtu and wtec-ascii") ------------------
 
 /// The position (0x0105) that closes (@p close) or opens the jaws. Position 0 % is the
@@ -96,39 +84,6 @@ template <std::uint16_t Address>
 }  // namespace
 
 OperationSet wtec_operations() { return OperationSet{"wtec", wtec_operation_table()}; }
-
-std::vector<RegisterDef> wtec_uniform_defs(bool ascii_view) {
-    using namespace wtec_reg;
-    std::vector<RegisterDef> defs;
-    // Table 2.3: "写入0x0001表示回零位"; not readable (table 2.2 has no read).
-    RegisterDef init = reg(initialize, "initialize", Access::write, 1, 1);
-    init.motion = true;
-    defs.push_back(std::move(init));
-    // Table 2.12: 1 e-stops, "只能通过初始化解锁" (only initialising releases it).
-    RegisterDef stop = reg(estop, "estop", Access::read_write, 1, 1);
-    stop.motion = true;
-    stop.stop_value = 1;
-    defs.push_back(std::move(stop));
-    defs.push_back(reg(force, "force", Access::read_write, 20, 100));  // table 2.5
-    defs.push_back(reg(speed, "speed", Access::read_write, 1, 100));   // table 2.7
-    RegisterDef pos = reg(position, "position", Access::read_write, 0, 100);  // table 2.6: "运行电爪并配置位置"
-    pos.motion = true;
-    defs.push_back(std::move(pos));
-    defs.push_back(reg(init_state, "init state", Access::read, 0, 0xFFFF));
-    defs.push_back(reg(grip_state, "grip state", Access::read, 0, 0xFFFF));
-    defs.push_back(reg(instant_position, "instant position", Access::read, 0, 100));
-    defs.push_back(reg(init_direction, "init direction", Access::read_write, 1, 2));  // table 2.9
-    RegisterDef flash = ascii_view ? reg(save, "save", Access::write, 1, 1)
-                                   : reg(save, "save", Access::read_write, 0, 1);  // table 2.10
-    flash.protect = true;
-    defs.push_back(std::move(flash));
-    // Table 2.11 allows 0-255; 0 is the broadcast address and the ASCII protocol
-    // stops at 253 (0xFD): 1-253 in both modes.
-    RegisterDef id = reg(device_id, "device id", Access::read_write, 1, 253);
-    id.protect = true;
-    defs.push_back(std::move(id));
-    return defs;
-}
 
 std::string_view wtec_init_state_name(std::uint16_t value) noexcept {
     switch (value) {

@@ -87,10 +87,6 @@ namespace fieldbridge::engine {
 /// read the init direction (0x0300) from the registers they are given.
 [[nodiscard]] OperationSet wtec_operations();
 
-/// The uniform holding registers. @p ascii_view: 0x0302 is write-only (no ASCII
-/// command reads the "saved" flag) and takes 1 only (0 has no ASCII counterpart).
-[[nodiscard]] std::vector<RegisterDef> wtec_uniform_defs(bool ascii_view);
-
 /// Seed 003 table 2.4: "not_initialized", "initialized", "failed", "initializing".
 [[nodiscard]] std::string_view wtec_init_state_name(std::uint16_t value) noexcept;
 /// Seed 003 table 2.8: "moving", "reached", "gripped", "motor_released".

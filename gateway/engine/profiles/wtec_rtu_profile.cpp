@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "engine/profiles/builtin_map.hpp"
 #include "engine/profiles/wtec_common.hpp"
 
 namespace fieldbridge::engine {
@@ -20,7 +21,7 @@ namespace {
 IdentificationRead wtec_rtu_identification() noexcept { return IdentificationRead{wtec_reg::device_id, 1}; }
 
 WtecRtuProfile::WtecRtuProfile(const ProfileOptions& options)
-    : ModbusProfile(std::make_shared<const RegisterMap>(wtec_uniform_defs(false)), wtec_rtu_wire_functions(), options,
+    : ModbusProfile(builtin_register_map(DeviceType::wtec_rtu, options), wtec_rtu_wire_functions(), options,
                     WordOrder::high_first) {}
 
 std::vector<PollUnit> WtecRtuProfile::poll_units() const {

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "engine/profiles/builtin_map.hpp"
 #include "engine/profiles/profile_text.hpp"
 
 namespace fieldbridge::engine {
@@ -27,14 +28,12 @@ constexpr std::uint16_t xeg_reset = 0x0610;
 constexpr std::uint16_t xeg_stop = 0x0620;
 constexpr std::uint16_t move_position = 0x0630;
 constexpr std::uint16_t move_speed = 0x0631;
-constexpr std::uint16_t move_flag = 0x0632;
 constexpr std::uint16_t expert_direction = 0x0640;
 constexpr std::uint16_t expert_move = 0x0641;
 constexpr std::uint16_t expert_speed = 0x0642;
 constexpr std::uint16_t hold_stroke = 0x0643;
 constexpr std::uint16_t hold_speed = 0x0644;
 constexpr std::uint16_t hold_force = 0x0645;
-constexpr std::uint16_t expert_flag = 0x0646;
 
 constexpr std::uint16_t status_working = 1;
 
@@ -50,59 +49,6 @@ constexpr std::array<XegModelLimits, 5> model_table{{
 
 constexpr std::array<std::string_view, 8> di_names{"in1", "in2", "in3", "in4", "in5", "in6", "start", "di7"};
 constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1", "alm2", "chk1", "chk2", "chk3"};
-
-[[nodiscard]] RegisterDef reg(Table table, std::uint16_t address, std::string name, Access access,
-                              std::int64_t min = 0, std::int64_t max = 0xFFFF, std::uint16_t count = 1) {
-    RegisterDef d;
-    d.table = table;
-    d.address = address;
-    d.count = count;
-    d.access = access;
-    d.min = min;
-    d.max = max;
-    d.name = std::move(name);
-    return d;
-}
-
-[[nodiscard]] RegisterDef motion(RegisterDef d, bool auto_reset = false) {
-    d.motion = true;
-    d.auto_reset = auto_reset;
-    return d;
-}
-
-[[nodiscard]] std::shared_ptr<const RegisterMap> xeg_register_map() {
-    using enum core::RegisterTable;  // clang takes no alias in a using-enum-declaration
-    std::vector<RegisterDef> defs{
-        reg(discrete_inputs, di_first, "DI", Access::read, 0, 1, 8),
-        reg(discrete_inputs, do_first, "DO", Access::read, 0, 1, 8),
-        reg(input, actual_position, "position", Access::read),
-        reg(input, status, "status", Access::read),
-        reg(input, firmware, "firmware", Access::read, 0, 0xFFFF, 4),
-    };
-    // §3 gives 0-2660 for the model; check_value() narrows it to the §3.3 list.
-    // Writable like any holding register: it is the first step of commissioning
-    // (Appendix 1, scenario 1) and changes nothing about communication (the ID is a
-    // rotary switch, the baud rate fixed), so it is not among the protected
-    // registers of spec §4 (device ID, flash save, baud / mode).
-    defs.push_back(reg(holding, model, "EG type", Access::read_write, 0, 2660));
-    // §3 gives the trigger as 1-63 (§3.4.1 says 0-63: 0 would trigger nothing).
-    defs.push_back(motion(reg(holding, xeg_trigger, "trigger", Access::read_write, 1, 63), true));
-    defs.push_back(motion(reg(holding, xeg_reset, "reset", Access::read_write, 0, 1), true));
-    RegisterDef stop = motion(reg(holding, xeg_stop, "stop", Access::read_write, 0, 1), true);
-    stop.stop_value = 1;
-    defs.push_back(std::move(stop));
-    defs.push_back(motion(reg(holding, move_position, "move", Access::read_write, 0, 6400)));
-    defs.push_back(motion(reg(holding, move_speed, "move speed", Access::read_write, 0, 10000)));
-    defs.push_back(motion(reg(holding, move_flag, "move flag", Access::read_write, 0, 1), true));
-    defs.push_back(motion(reg(holding, expert_direction, "expert direction", Access::read_write, 0, 1)));
-    defs.push_back(motion(reg(holding, expert_move, "expert move", Access::read_write, 0, 6400)));
-    defs.push_back(motion(reg(holding, expert_speed, "expert speed", Access::read_write, 0, 10000)));
-    defs.push_back(motion(reg(holding, hold_stroke, "holding stroke", Access::read_write, 0, 6400)));
-    defs.push_back(motion(reg(holding, hold_speed, "holding speed", Access::read_write, 0, 2000)));
-    defs.push_back(motion(reg(holding, hold_force, "holding force", Access::read_write, 40, 100)));
-    defs.push_back(motion(reg(holding, expert_flag, "expert flag", Access::read_write, 0, 1), true));
-    return std::make_shared<const RegisterMap>(std::move(defs));
-}
 
 [[nodiscard]] WireFunctions xeg_wire_functions() {
     // Seed 001 §4.1 function code table; FC06 is accepted northbound and translated.
@@ -201,7 +147,8 @@ std::string_view xeg_status_name(std::uint16_t value) noexcept {
 OperationSet xeg_operations() { return OperationSet{"xeg", xeg_operation_table()}; }
 
 XegProfile::XegProfile(const ProfileOptions& options)
-    : ModbusProfile(xeg_register_map(), xeg_wire_functions(), options, WordOrder::high_first) {}
+    : ModbusProfile(builtin_register_map(DeviceType::hiwin_xeg, options), xeg_wire_functions(), options,
+                    WordOrder::high_first) {}
 
 std::optional<ExceptionCode> XegProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
                                                      std::int64_t value, const RegisterImage& image) const {

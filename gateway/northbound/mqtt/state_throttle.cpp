@@ -35,8 +35,10 @@ namespace {
     return largest;
 }
 
-[[nodiscard]] bool field_differs(const engine::Field& before, const engine::Field& after,
-                                 const std::map<std::string, double, std::less<>>& deadband) {
+}  // namespace
+
+bool field_differs(const engine::Field& before, const engine::Field& after,
+                   const std::map<std::string, double, std::less<>>& deadband) {
     if (before.value == after.value) {
         return false;
     }
@@ -53,8 +55,6 @@ namespace {
     }
     return std::fabs(*b - *a) >= band->second;
 }
-
-}  // namespace
 
 bool state_differs(const SourceState& published, const SourceState& now,
                    const std::map<std::string, double, std::less<>>& deadband) {

@@ -21,6 +21,11 @@ struct ThrottleSettings {
     std::map<std::string, double, std::less<>> deadband;  ///< field name -> smallest change published
 };
 
+/// True when the field @p after differs from @p before by more than its deadband in
+/// @p deadband allows (a list: its largest element change); any change without one.
+[[nodiscard]] bool field_differs(const engine::Field& before, const engine::Field& after,
+                                 const std::map<std::string, double, std::less<>>& deadband);
+
 /// True when @p now differs from @p published by more than the deadbands allow.
 [[nodiscard]] bool state_differs(const SourceState& published, const SourceState& now,
                                  const std::map<std::string, double, std::less<>>& deadband);

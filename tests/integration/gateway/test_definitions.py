@@ -4,10 +4,12 @@ simulator runs the same file, and the device is read, written and alarmed throug
 Modbus TCP and MQTT: fields in engineering units with units and enum labels, point
 checks on TCP writes (min / max after scale, a value written whole), the `write` op
 (all or nothing) and the `read` op, and alarms from a bit and from a threshold with
-hysteresis."""
+hysteresis. And a built-in type's definition file: an operator's copy takes effect,
+and the compiled-in definition stands in once the copy is gone."""
 
 import json
 import os
+import signal
 import struct
 
 import gatewaylib
@@ -162,6 +164,46 @@ class DefinitionDevice(gatewaylib.CellTestCase):
         overvoltage = [e["event"] for e in events if e.get("code") == "overvoltage"]
         self.assertEqual(overvoltage, ["raised", "cleared"], events)
         self.assertEqual(cleared["source"], "point voltage")
+
+
+SHIPPED = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, os.pardir,
+                                        "config", "devices"))
+ABS_ROW = "{name: abs, address: 0x0100, width: 2, access: write, motion: true, min: -8300000, max: 8300000}"
+
+
+class BuiltInDefinition(gatewaylib.CellTestCase):
+    """A built-in type's register map is its definition (docs/devices.md, "Built-in
+    types"): an operator's copy of excd203mb.yaml in the definitions: directory narrows
+    what clients may write to the EXCD203MB of the cell; with the copy removed, a
+    reload brings back the definition compiled into fieldbridge."""
+
+    def test_an_operators_copy_narrows_abs_and_a_reload_without_it_restores_the_compiled_in_map(self):
+        definitions = self.path("devices")
+        os.mkdir(definitions)
+        with open(os.path.join(SHIPPED, "excd203mb.yaml"), encoding="utf-8") as f:
+            text = f.read()
+        self.assertIn(ABS_ROW, text)
+        copy = os.path.join(definitions, "excd203mb.yaml")
+        with open(copy, "w", encoding="utf-8") as f:
+            f.write(text.replace(ABS_ROW, ABS_ROW.replace("min: -8300000, max: 8300000", "min: 0, max: 100000")))
+        self.start_cell(rules="definitions: [%s]\n" % definitions)
+        client = self.client()
+        stepper = 2
+        # abs 100001 (0x000186A1): the shipped range allows it, the site's copy does not.
+        self.assert_exception(client.write_registers(0x0100, [0x0001, 0x86A1], slave=stepper), 0x03)
+        self.assert_ok(client.write_registers(0x0100, [0x0001, 0x86A0], slave=stepper))
+        # The rest of the map as shipped: rabs reads, a hole is 0x02.
+        self.assert_ok(client.read_holding_registers(0x0201, count=2, slave=stepper))
+        self.assert_exception(client.read_holding_registers(0x003D, count=1, slave=stepper), 0x02)
+
+        os.remove(copy)
+        mark = self.gateway.mark()
+        self.gateway.signal(signal.SIGHUP)
+        if self.gateway.wait_line(lambda line: "configuration reloaded" in line, 10, start=mark) is None:
+            self.fail("reload not applied:\n%s" % self.gateway.text())
+        client = self.client()
+        self.wait_value(lambda: client.write_registers(0x0100, [0x0001, 0x86A1], slave=stepper).isError(), False, 5,
+                        "abs 100001 accepted with the compiled-in definition")
 
 
 if __name__ == "__main__":

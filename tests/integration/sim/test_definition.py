@@ -2,8 +2,8 @@
 "Definitions"): the shipped worked example (config/devices/example-thermostat.yaml)
 on a pseudo-terminal answers exactly its points' registers (02 elsewhere), takes
 values by point name in engineering units and by raw register through the control
-socket, and keeps what the master writes. A type with no definition, and a broken
-definition, stop the start with the reason."""
+socket, and keeps what the master writes. A type with no definition, a broken
+definition, and a site's variant of a built-in type stop the start with the reason."""
 
 import os
 import struct
@@ -78,6 +78,16 @@ class Definition(simlib.SimTestCase):
         self.assertNotEqual(broken.returncode, 0)
         self.assertIn(self.path("broken.yaml") + ":3:47: points[0].type: table coils holds single bits",
                       broken.stderr)
+
+        # A site's variant of a built-in type (docs/devices.md, "Built-in types"): the
+        # simulator names the built-in model to use instead.
+        with open(self.path("excd-slow.yaml"), "w") as f:
+            f.write("name: excd-slow\nbehaviour: excd203mb\nregisters: [{name: x, address: 0, access: read}]\n")
+        variant = subprocess.run([simlib.SIM, "--definitions", self.tmp, "--bus", self.path("line-d") + ":excd-slow@3"],
+                                 capture_output=True, text=True, timeout=20)
+        self.assertNotEqual(variant.returncode, 0)
+        self.assertIn("is a variant of the built-in type excd203mb (behaviour: excd203mb); simulate it as excd203mb@3",
+                      variant.stderr)
 
 
 if __name__ == "__main__":

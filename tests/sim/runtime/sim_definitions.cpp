@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <string_view>
 
 #include "config/device_definition.hpp"
 #include "sim_error.hpp"
@@ -56,12 +57,22 @@ void attach_definitions(std::vector<BusSpec>& buses, const std::vector<std::stri
                                                bus.name, device.type, device.address, device.type,
                                                fmt::join(built_in, ", "), device.type, searched(dirs, files)));
                 }
+                config::DeviceDefinition definition;
                 try {
-                    it = loaded.emplace(device.type, spec_of(config::load_definition_file(*file))).first;
+                    definition = config::load_definition_file(*file);
                 } catch (const config::ConfigError& e) {
                     throw SimError(fmt::format("--bus {}: device {}@{}: the definition has problems:\n{}", bus.name,
                                                device.type, device.address, e.what()));
                 }
+                if (definition.behaviour) {
+                    // A site's variant of a built-in type: the simulator's model of that type.
+                    const std::string_view type = core::to_string(*definition.behaviour);
+                    throw SimError(fmt::format("--bus {}: device {}@{}: {} is a variant of the built-in type {} "
+                                               "(behaviour: {}); simulate it as {}@{}",
+                                               bus.name, device.type, device.address, file->string(), type, type,
+                                               type, device.address));
+                }
+                it = loaded.emplace(device.type, spec_of(definition)).first;
             }
             device.options.definition = it->second;
         }

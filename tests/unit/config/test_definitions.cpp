@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "config/builtin_definitions.hpp"
 #include "config/device_definition.hpp"
 #include "config_test_support.hpp"
 #include "temp_dir.hpp"
@@ -287,4 +288,201 @@ TEST_CASE("the shipped definitions (config/devices) load without a problem; the 
     CHECK(example->points.alarms[0].condition == AlarmCondition::bit);
     REQUIRE(example->identify.has_value());
     CHECK(example->identify->expect == std::vector<std::uint16_t>{0x5448});
+}
+
+// ---- the built-in types as definitions (docs/devices.md, "Built-in types") --------
+
+namespace {
+
+std::string shipped_text(std::string_view name) {
+    std::ifstream in(std::filesystem::path(FIELDBRIDGE_SHIPPED_DEFINITIONS) / (std::string(name) + ".yaml"),
+                     std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// @p text with its one @p from replaced by @p to.
+std::string replaced(std::string text, std::string_view from, std::string_view to) {
+    const auto at = text.find(from);
+    REQUIRE_MESSAGE(at != std::string::npos, "the shipped text has no '" << from << "'");
+    return text.replace(at, from.size(), to);
+}
+
+/// Line and column (1-based) of @p needle in @p text.
+std::pair<int, int> position_of(std::string_view text, std::string_view needle) {
+    const auto at = text.find(needle);
+    REQUIRE(at != std::string_view::npos);
+    const auto line_start = text.rfind('\n', at);
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+    const auto column = at - (line_start == std::string_view::npos ? 0 : line_start + 1) + 1;
+    return {static_cast<int>(line), static_cast<int>(column)};
+}
+
+const fieldbridge::core::RegisterDef& row_named(const std::vector<fieldbridge::core::RegisterDef>& rows,
+                                                std::string_view name) {
+    const auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.name == name; });
+    REQUIRE_MESSAGE(it != rows.end(), "no register " << name);
+    return *it;
+}
+
+constexpr std::string_view excd_abs_row =
+    "{name: abs, address: 0x0100, width: 2, access: write, motion: true, min: -8300000, max: 8300000}";
+
+}  // namespace
+
+TEST_CASE("every built-in type's compiled-in definition is its shipped file in config/devices") {
+    REQUIRE_FALSE(builtin_definition_texts().empty());
+    for (const BuiltinText& builtin : builtin_definition_texts()) {
+        INFO(builtin.name);
+        CHECK(builtin.text == shipped_text(builtin.name));
+        const auto type = fieldbridge::core::parse<DeviceType>(builtin.name);
+        REQUIRE(type.has_value());
+        const DeviceDefinition* compiled = builtin_definition(*type);
+        REQUIRE(compiled != nullptr);
+        CHECK(compiled->behaviour == type);
+        CHECK(compiled->file == builtin_definition_path(builtin.name));
+        DeviceDefinition file = load_definition_file(std::filesystem::path(FIELDBRIDGE_SHIPPED_DEFINITIONS) /
+                                                     (std::string(builtin.name) + ".yaml"));
+        file.file = compiled->file;
+        CHECK(file == *compiled);
+    }
+    CHECK(builtin_definition(DeviceType::modbus) == nullptr);
+}
+
+TEST_CASE("excd203mb's definition: the register map of docs/registers.md") {
+    const DeviceDefinition* excd = builtin_definition(DeviceType::excd203mb);
+    REQUIRE(excd != nullptr);
+    const auto& rows = excd->registers;
+    CHECK(rows.size() == 77);
+    const auto& abs = row_named(rows, "abs");
+    CHECK(abs.address == 0x0100);
+    CHECK(abs.width == 2);
+    CHECK(abs.access == fieldbridge::core::Access::write);
+    CHECK(abs.is_signed);
+    CHECK(abs.min == -8'300'000);
+    CHECK(abs.motion);
+    CHECK(row_named(rows, "jog stop").stop_value == 0);
+    CHECK(row_named(rows, "save").protect);
+    CHECK(row_named(rows, "n").count == 99);
+    CHECK(row_named(rows, "ver").max == 0xFFFF'FFFF);
+    CHECK_FALSE(row_named(rows, "ver").is_signed);
+}
+
+TEST_CASE("a built-in type without a file of its name uses the compiled-in definition") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    std::filesystem::create_directories(dir.path() / "devices");
+    const auto config = load_in(dir.path() / "gw.yaml", config_text("excd203mb", "", "definitions: [devices]\n"));
+    const DeviceConfig& device = config->lines.at(0).devices.at(0);
+    CHECK(device.type == DeviceType::excd203mb);
+    CHECK(device.registers.empty());
+    CHECK(device.definition_file.empty());
+}
+
+TEST_CASE("an operator's copy of a built-in definition replaces the compiled-in one") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto copy = dir.path() / "devices" / "excd203mb.yaml";
+    write_file(copy, replaced(shipped_text("excd203mb"), excd_abs_row,
+                              "{name: abs, address: 0x0100, width: 2, access: write, motion: true, min: 0, "
+                              "max: 100000}"));
+    const auto config = load_in(dir.path() / "gw.yaml", config_text("excd203mb", "", "definitions: [devices]\n"));
+    const DeviceConfig& device = config->lines.at(0).devices.at(0);
+    CHECK(device.type == DeviceType::excd203mb);
+    CHECK(device.definition_file == copy.string());
+    REQUIRE(device.registers.size() == 77);
+    CHECK(row_named(device.registers, "abs").min == 0);
+    CHECK(row_named(device.registers, "abs").max == 100000);
+    CHECK_FALSE(row_named(device.registers, "abs").is_signed);
+}
+
+TEST_CASE("a site's variant of a built-in type: a definition of its own name with behaviour:") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    write_file(dir.path() / "devices" / "excd-slow.yaml",
+               replaced(shipped_text("excd203mb"), "name: excd203mb\n", "name: excd-slow\n"));
+    const auto config = load_in(dir.path() / "gw.yaml", config_text("excd-slow", "", "definitions: [devices]\n"));
+    const DeviceConfig& device = config->lines.at(0).devices.at(0);
+    CHECK(device.type == DeviceType::excd203mb);
+    CHECK(device.type_name == "excd-slow");
+    CHECK(device.registers.size() == 77);
+}
+
+TEST_CASE("a broken copy of a built-in definition is refused at file:line:col of the copy") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto copy = dir.path() / "devices" / "excd203mb.yaml";
+    SUBCASE("a value out of range") {
+        const std::string text = replaced(shipped_text("excd203mb"), "{name: hdir, address: 0x0000, access: "
+                                                                     "read_write, min: 0, max: 1}",
+                                          "{name: hdir, address: 0x0000, access: read_write, min: 0, max: 0x10000}");
+        write_file(copy, text);
+        const auto [line, column] = position_of(text, "0x10000}");
+        const auto diagnostics = diagnostics_in(dir.path() / "gw.yaml",
+                                                config_text("excd203mb", "", "definitions: [devices]\n"));
+        require_diagnostic(diagnostics, copy, line, column, {"65536 is out of range", "0..65535"});
+        require_diagnostic(diagnostics, dir.path() / "gw.yaml", 8, 15,
+                           {"replaces the built-in excd203mb", "has problems", "remove the file"});
+    }
+    SUBCASE("two rows over one register") {
+        const std::string text = replaced(shipped_text("excd203mb"), "{name: hvs, address: 0x0001,",
+                                          "{name: hvs, address: 0x0000,");
+        write_file(copy, text);
+        const auto [line, column] = position_of(text, "{name: hvs");
+        require_diagnostic(diagnostics_in(dir.path() / "gw.yaml",
+                                          config_text("excd203mb", "", "definitions: [devices]\n")),
+                           copy, line, column, {"overlap", "registers[0]"});
+    }
+    SUBCASE("without behaviour:") {
+        const std::string text = replaced(shipped_text("excd203mb"), "behaviour: excd203mb\n", "");
+        write_file(copy, text);
+        const auto [line, column] = position_of(text, "- {name: hdir");
+        const auto diagnostics = diagnostics_in(dir.path() / "gw.yaml",
+                                                config_text("excd203mb", "", "definitions: [devices]\n"));
+        require_diagnostic(diagnostics, copy, line, column, {"registers: describe a built-in type's map"});
+        require_diagnostic(diagnostics, dir.path() / "gw.yaml", 8, 15, {"replaces the built-in excd203mb"});
+    }
+}
+
+TEST_CASE("an unknown behaviour hook is refused with the known ones") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto file = dir.path() / "devices" / "acme.yaml";
+    write_file(file, "name: acme\n"
+                     "behaviour: acme-gripper\n"
+                     "registers: [{name: x, address: 0, access: read}]\n");
+    const auto diagnostics = diagnostics_in(dir.path() / "gw.yaml", config_text("acme", "", "definitions: [devices]\n"));
+    require_diagnostic(diagnostics, file, 2, 12,
+                       {"'acme-gripper' is not allowed", "hiwin-xeg, excd203mb, wtec-rtu, wtec-ascii"});
+    CHECK(diagnostics.size() == 2);  // and the device's line that names the definition
+}
+
+TEST_CASE("behaviour: takes registers, not points; registers need behaviour:") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto hook = dir.path() / "devices" / "hook.yaml";
+    write_file(hook, "name: hook\n"
+                     "behaviour: excd203mb\n"
+                     "registers: [{name: x, address: 0, access: read}]\n"
+                     "points: [{name: y, table: holding, address: 1}]\n");
+    require_diagnostic(diagnostics_in(dir.path() / "gw.yaml", config_text("hook", "", "definitions: [devices]\n")),
+                       hook, 4, 9, {"describes its registers:", "remove this key"});
+    const auto generic = dir.path() / "devices" / "generic.yaml";
+    write_file(generic, "name: generic\n"
+                        "points: [{name: y, table: holding, address: 1}]\n"
+                        "registers: [{name: x, address: 0, access: read}]\n");
+    require_diagnostic(diagnostics_in(dir.path() / "gw.yaml", config_text("generic", "", "definitions: [devices]\n")),
+                       generic, 3, 12, {"without behaviour: is a generic device"});
+}
+
+TEST_CASE("registers: rows of a read-only table are read-only; widths, counts and ranges are checked") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto file = dir.path() / "devices" / "hook.yaml";
+    write_file(file, "name: hook\n"
+                     "behaviour: wtec-rtu\n"
+                     "registers:\n"
+                     "  - {name: a, table: input, address: 0, access: read_write}\n"
+                     "  - {name: b, address: 1, width: 3, access: read}\n"
+                     "  - {name: c, address: 0xFFFF, width: 2, access: read}\n"
+                     "  - {name: d, address: 2, access: write, min: 5, max: 4}\n"
+                     "  - {name: e, table: coils, address: 0, width: 2, access: read}\n");
+    const auto diagnostics = diagnostics_in(dir.path() / "gw.yaml", config_text("hook", "", "definitions: [devices]\n"));
+    require_diagnostic(diagnostics, file, 4, 49, {"input cannot be written", "access: read"});
+    require_diagnostic(diagnostics, file, 5, 34, {"3 is out of range", "1..2"});
+    require_diagnostic(diagnostics, file, 6, 5, {"runs past register 0xFFFF"});
+    require_diagnostic(diagnostics, file, 7, 55, {"max 4 is below min 5"});
+    require_diagnostic(diagnostics, file, 8, 48, {"one bit wide"});
 }

@@ -9,6 +9,7 @@
 #include "engine/points/point_requests.hpp"
 #include "engine/profiles/generic_profile.hpp"
 #include "support.hpp"
+#include "point_builders.hpp"
 
 namespace {
 
@@ -19,46 +20,38 @@ using fp::ExceptionCode;
 using std::chrono::milliseconds;
 using Regs = std::vector<std::uint16_t>;
 
-fc::PointDef pt(std::string name, Table table, std::uint16_t address, fc::PointType type, bool writable = false) {
-    fc::PointDef p;
-    p.name = std::move(name);
-    p.table = table;
-    p.address = address;
-    p.type = type;
-    p.writable = writable;
-    return p;
-}
+using fieldbridge::test::point_def;
 
 /// A thermostat-like device: the example of docs/devices.md.
 fc::PointModel thermo_points() {
     fc::PointModel m;
-    fc::PointDef temperature = pt("temperature", Table::input, 0x0000, fc::PointType::float32);
+    fc::PointDef temperature = point_def("temperature", Table::input, 0x0000, fc::PointType::float32);
     temperature.unit = "°C";
     m.points.push_back(temperature);
-    m.points.push_back(pt("humidity", Table::input, 0x0002, fc::PointType::uint16));
-    m.points.push_back(pt("energy", Table::input, 0x0010, fc::PointType::int32));
-    fc::PointDef setpoint = pt("setpoint", Table::holding, 0x0100, fc::PointType::int16, true);
+    m.points.push_back(point_def("humidity", Table::input, 0x0002, fc::PointType::uint16));
+    m.points.push_back(point_def("energy", Table::input, 0x0010, fc::PointType::int32));
+    fc::PointDef setpoint = point_def("setpoint", Table::holding, 0x0100, fc::PointType::int16, true);
     setpoint.scale = 0.1;
     setpoint.min = 5.0;
     setpoint.max = 30.0;
     setpoint.unit = "°C";
     m.points.push_back(setpoint);
-    fc::PointDef mode = pt("mode", Table::holding, 0x0101, fc::PointType::uint16, true);
+    fc::PointDef mode = point_def("mode", Table::holding, 0x0101, fc::PointType::uint16, true);
     mode.labels = {{0, "off"}, {1, "heat"}, {2, "cool"}};
     m.points.push_back(mode);
-    fc::PointDef eco = pt("eco", Table::holding, 0x0102, fc::PointType::boolean, true);
+    fc::PointDef eco = point_def("eco", Table::holding, 0x0102, fc::PointType::boolean, true);
     eco.bit = 4;
     m.points.push_back(eco);
-    fc::PointDef lock = pt("keypad_locked", Table::holding, 0x0102, fc::PointType::boolean, true);
+    fc::PointDef lock = point_def("keypad_locked", Table::holding, 0x0102, fc::PointType::boolean, true);
     lock.bit = 0;
     m.points.push_back(lock);
-    m.points.push_back(pt("limit", Table::holding, 0x0200, fc::PointType::float64, true));
-    m.points.push_back(pt("serial", Table::holding, 0x0300, fc::PointType::uint32));
-    fc::PointDef name = pt("model_name", Table::holding, 0x0310, fc::PointType::string);
+    m.points.push_back(point_def("limit", Table::holding, 0x0200, fc::PointType::float64, true));
+    m.points.push_back(point_def("serial", Table::holding, 0x0300, fc::PointType::uint32));
+    fc::PointDef name = point_def("model_name", Table::holding, 0x0310, fc::PointType::string);
     name.count = 4;
     m.points.push_back(name);
-    m.points.push_back(pt("relay", Table::coils, 0x0007, fc::PointType::boolean, true));
-    m.points.push_back(pt("status", Table::input, 0x0020, fc::PointType::uint16));
+    m.points.push_back(point_def("relay", Table::coils, 0x0007, fc::PointType::boolean, true));
+    m.points.push_back(point_def("status", Table::input, 0x0020, fc::PointType::uint16));
     m.points.back().period = milliseconds{100};
     return m;
 }
@@ -189,7 +182,7 @@ TEST_CASE("generic points: the poll plan merges neighbours across max_gap, each 
                             "04 00 20 00 01 @100",
                         });
     // A gap of 2 (0x0003-0x0004): bridged at the default 8, not at 0.
-    o.points.points.push_back(pt("outdoor", Table::input, 0x0005, fc::PointType::int16));
+    o.points.points.push_back(point_def("outdoor", Table::input, 0x0005, fc::PointType::int16));
     o.points.max_gap = 8;
     CHECK(plan_of(o)[6] == "04 00 00 00 06 @1000");
     o.points.max_gap = 0;
@@ -306,17 +299,17 @@ TEST_CASE("generic points: a model the map cannot hold is refused with a reason"
     fe::ProfileOptions o;
     o.points = thermo_points();
     CHECK(refusal_of(o).empty());  // points alone are enough
-    o.points.points.push_back(pt("overlap", Table::input, 0x0001, fc::PointType::uint16));
+    o.points.points.push_back(point_def("overlap", Table::input, 0x0001, fc::PointType::uint16));
     CHECK(refusal_of(o).find("point 'temperature' (input 0x0000) and point 'overlap' (input 0x0001) overlap") !=
           std::string::npos);
     o.points = thermo_points();
-    o.points.points.push_back(pt("wrong", Table::input, 0x0050, fc::PointType::uint16, true));
+    o.points.points.push_back(point_def("wrong", Table::input, 0x0050, fc::PointType::uint16, true));
     CHECK(refusal_of(o).find("point 'wrong' (input 0x0050) is marked writable") != std::string::npos);
     o.points = thermo_points();
-    o.points.points.push_back(pt("tail", Table::holding, 0xFFFF, fc::PointType::uint32));
+    o.points.points.push_back(point_def("tail", Table::holding, 0xFFFF, fc::PointType::uint32));
     CHECK(refusal_of(o).find("runs past address 0xFFFF") != std::string::npos);
     o.points = thermo_points();
-    o.points.points.push_back(pt("empty", Table::holding, 0x0400, fc::PointType::string));
+    o.points.points.push_back(point_def("empty", Table::holding, 0x0400, fc::PointType::string));
     CHECK(refusal_of(o).find("check its `count`") != std::string::npos);
     o.points = thermo_points();
     fc::AlarmRule orphan;

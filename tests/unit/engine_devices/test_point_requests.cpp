@@ -6,6 +6,7 @@
 
 #include "engine/points/point_requests.hpp"
 #include "vectors.hpp"
+#include "point_builders.hpp"
 
 namespace {
 
@@ -14,37 +15,28 @@ namespace fp = fieldbridge::protocol;
 namespace pts = fieldbridge::engine::points;
 using fieldbridge::test::hex;
 
-fc::PointDef def(std::string name, fc::RegisterTable table, std::uint16_t address, fc::PointType type,
-                 bool writable = false) {
-    fc::PointDef p;
-    p.name = std::move(name);
-    p.table = table;
-    p.address = address;
-    p.type = type;
-    p.writable = writable;
-    return p;
-}
+using fieldbridge::test::point_def;
 
 fc::PointModel thermostat() {
     fc::PointModel m;
-    m.points.push_back(def("temperature", fc::RegisterTable::input, 0x0000, fc::PointType::float32));
-    m.points.push_back(def("humidity", fc::RegisterTable::input, 0x0002, fc::PointType::uint16));
-    m.points.push_back(def("energy", fc::RegisterTable::input, 0x0010, fc::PointType::int32));
-    fc::PointDef setpoint = def("setpoint", fc::RegisterTable::holding, 0x0100, fc::PointType::int16, true);
+    m.points.push_back(point_def("temperature", fc::RegisterTable::input, 0x0000, fc::PointType::float32));
+    m.points.push_back(point_def("humidity", fc::RegisterTable::input, 0x0002, fc::PointType::uint16));
+    m.points.push_back(point_def("energy", fc::RegisterTable::input, 0x0010, fc::PointType::int32));
+    fc::PointDef setpoint = point_def("setpoint", fc::RegisterTable::holding, 0x0100, fc::PointType::int16, true);
     setpoint.scale = 0.1;
     setpoint.min = 5.0;
     setpoint.max = 30.0;
     m.points.push_back(setpoint);
-    fc::PointDef mode = def("mode", fc::RegisterTable::holding, 0x0101, fc::PointType::uint16, true);
+    fc::PointDef mode = point_def("mode", fc::RegisterTable::holding, 0x0101, fc::PointType::uint16, true);
     mode.labels = {{0, "off"}, {1, "heat"}, {2, "cool"}};
     m.points.push_back(mode);
-    fc::PointDef eco = def("eco", fc::RegisterTable::holding, 0x0102, fc::PointType::boolean, true);
+    fc::PointDef eco = point_def("eco", fc::RegisterTable::holding, 0x0102, fc::PointType::boolean, true);
     eco.bit = 4;
     m.points.push_back(eco);
-    m.points.push_back(def("relay", fc::RegisterTable::coils, 0x0007, fc::PointType::boolean, true));
-    m.points.push_back(def("limit", fc::RegisterTable::holding, 0x0200, fc::PointType::float64, true));
-    m.points.push_back(def("serial", fc::RegisterTable::holding, 0x0300, fc::PointType::uint32));
-    m.points.push_back(def("door", fc::RegisterTable::discrete_inputs, 0x0003, fc::PointType::boolean, true));
+    m.points.push_back(point_def("relay", fc::RegisterTable::coils, 0x0007, fc::PointType::boolean, true));
+    m.points.push_back(point_def("limit", fc::RegisterTable::holding, 0x0200, fc::PointType::float64, true));
+    m.points.push_back(point_def("serial", fc::RegisterTable::holding, 0x0300, fc::PointType::uint32));
+    m.points.push_back(point_def("door", fc::RegisterTable::discrete_inputs, 0x0003, fc::PointType::boolean, true));
     return m;
 }
 
@@ -129,9 +121,9 @@ TEST_CASE("point requests: reads merged where adjacent, by table then address") 
 
 TEST_CASE("point requests: a merged read stays within 125 registers") {
     fc::PointModel m;
-    m.points.push_back(def("a", fc::RegisterTable::holding, 0, fc::PointType::string));
+    m.points.push_back(point_def("a", fc::RegisterTable::holding, 0, fc::PointType::string));
     m.points.back().count = 100;
-    m.points.push_back(def("b", fc::RegisterTable::holding, 100, fc::PointType::string));
+    m.points.push_back(point_def("b", fc::RegisterTable::holding, 100, fc::PointType::string));
     m.points.back().count = 30;
     const std::vector<std::string> names{"a", "b"};
     CHECK(pdus(pts::read_requests(m, names)) == std::vector<std::string>{"03 00 00 00 64", "03 00 64 00 1E"});

@@ -5,6 +5,7 @@
 #include "core/point.hpp"
 #include "northbound/mqtt/command_parser.hpp"
 #include "northbound/mqtt/point_commands.hpp"
+#include "point_builders.hpp"
 
 namespace {
 
@@ -13,34 +14,27 @@ namespace fe = fieldbridge::engine;
 namespace fm = fieldbridge::northbound::mqtt;
 namespace fp = fieldbridge::protocol;
 
-core::PointDef point(std::string name, core::RegisterTable table, std::uint16_t address, core::PointType type) {
-    core::PointDef p;
-    p.name = std::move(name);
-    p.table = table;
-    p.address = address;
-    p.type = type;
-    return p;
-}
+using fieldbridge::test::point_def;
 
 /// A thermostat: float32 temperature (read-only), float32 setpoint 5..35 (writable),
 /// uint16 mode enum off/heat/cool (writable), a coil `enabled` (writable), a string name.
 core::PointModel thermostat() {
     core::PointModel model;
-    model.points.push_back(point("temperature", core::RegisterTable::input, 0x0000, core::PointType::float32));
-    auto setpoint = point("setpoint", core::RegisterTable::holding, 0x0010, core::PointType::float32);
+    model.points.push_back(point_def("temperature", core::RegisterTable::input, 0x0000, core::PointType::float32));
+    auto setpoint = point_def("setpoint", core::RegisterTable::holding, 0x0010, core::PointType::float32);
     setpoint.writable = true;
     setpoint.min = 5.0;
     setpoint.max = 35.0;
     setpoint.unit = "°C";
     model.points.push_back(setpoint);
-    auto mode = point("mode", core::RegisterTable::holding, 0x0012, core::PointType::uint16);
+    auto mode = point_def("mode", core::RegisterTable::holding, 0x0012, core::PointType::uint16);
     mode.writable = true;
     mode.labels = {{0, "off"}, {1, "heat"}, {2, "cool"}};
     model.points.push_back(mode);
-    auto enabled = point("enabled", core::RegisterTable::coils, 0x0003, core::PointType::boolean);
+    auto enabled = point_def("enabled", core::RegisterTable::coils, 0x0003, core::PointType::boolean);
     enabled.writable = true;
     model.points.push_back(enabled);
-    auto label = point("label", core::RegisterTable::holding, 0x0020, core::PointType::string);
+    auto label = point_def("label", core::RegisterTable::holding, 0x0020, core::PointType::string);
     label.count = 4;
     model.points.push_back(label);
     return model;
