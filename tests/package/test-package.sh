@@ -39,14 +39,17 @@ out="${FIELDBRIDGE_DEB_DIR:-$here/build-deb}"
 export FIELDBRIDGE_DEB_DIR="$out"
 native="$(dpkg --print-architecture)"
 arch="$native" dist=bookworm
-case "${1:-}" in
-  --arch) [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
-          arch="$2" ;;
-  --dist) [ $# -ge 2 ] || { echo "test-package: --dist needs a Debian release (bookworm or trixie)" >&2; exit 2; }
-          dist="$2" ;;
-esac
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --arch) [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
+            arch="$2"; shift 2 ;;
+    --dist) [ $# -ge 2 ] || { echo "test-package: --dist needs a Debian release (bookworm or trixie)" >&2; exit 2; }
+            dist="$2"; shift 2 ;;
+    *) echo "test-package: unknown argument '$1' (usage: test-package.sh [--dist bookworm|trixie] [--arch $native|arm64|armhf])" >&2; exit 2 ;;
+  esac
+done
 build_args=(--arch "$arch") build_name="$arch"
-if [ "$dist" != bookworm ]; then build_args=(--dist "$dist") build_name="$dist-$arch"; fi
+if [ "$dist" != bookworm ]; then build_args=(--dist "$dist" --arch "$arch") build_name="$dist-$arch"; fi
 
 started=$SECONDS
 if [ "${FIELDBRIDGE_DEB_PREBUILT:-0}" != 1 ]; then
@@ -83,9 +86,13 @@ contains() {  # contains TEXT PATTERN: grep -E PATTERN in TEXT, TEXT shown when 
 lacks() { ! grep -Eq -- "$2" <<<"$1" || { printf '/%s/ found in:\n%s\n' "$2" "$1"; return 1; }; }
 
 if [ "$dist" != bookworm ] && [ -z "${FIELDBRIDGE_IN_ROOT:-}" ]; then
-  # The checks below inside the release's build root, then the clean root's.
-  FIELDBRIDGE_DEB_PREBUILT=1 "$here/deploy/dist/in-root" "$dist" "$here/tests/package/test-package.sh"
-  version="$("$here/deploy/dist/in-root" "$dist" "$here/deploy/package-version")"
+  # The checks below inside the release's build root (for arm64 and armhf its cross
+  # root, with the cross checks), then the clean root's.
+  root_args=()
+  [ "$arch" = "$native" ] || root_args=(--arch "$arch")
+  FIELDBRIDGE_DEB_PREBUILT=1 "$here/deploy/dist/in-root" "${root_args[@]}" "$dist" \
+    "$here/tests/package/test-package.sh" "${root_args[@]}"
+  version="$("$here/deploy/dist/in-root" "${root_args[@]}" "$dist" "$here/deploy/package-version")"
   deb="$out/fieldbridge_${version}_${arch}.deb"
   sim_deb="$out/fieldbridge-sim_${version}_${arch}.deb"
   upstream_version="${version%%~*}"
