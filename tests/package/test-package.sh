@@ -30,7 +30,15 @@
 # copy each run; tests/package/clean-root-checks.sh): apt resolves their Depends from
 # Debian 13 alone, and the packaged fieldbridge checks its packaged configuration there.
 #
-# Usage: tests/package/test-package.sh [--arch ARCH | --dist DIST]
+# With --dist trixie --arch arm64 or armhf, the Debian 13 packages for that architecture
+# (deploy/build-deb --dist trixie --arch, built in the Debian 13 cross root): the --arch
+# checks above run inside that cross root (Debian 13's lintian and qemu-user, compared
+# with the Debian 13 amd64 packages), then the packages are installed by apt into a
+# clean Debian 13 root of this machine's architecture with ARCH added (multiarch), where
+# apt resolves their Depends from Debian 13's ARCH packages alone and the installed
+# programs run under qemu-user (tests/package/clean-root-checks.sh).
+#
+# Usage: tests/package/test-package.sh [--dist DIST] [--arch ARCH]
 #   FIELDBRIDGE_DEB_DIR        where the packages are built (default build-deb/)
 #   FIELDBRIDGE_DEB_PREBUILT=1 test the packages already in that directory, no build
 set -euo pipefail
