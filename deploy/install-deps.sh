@@ -11,6 +11,10 @@
 #                /var/cache/fieldbridge/root/DIST-amd64 by deploy/dist/make-root
 #                (docs/build.md, "Debian 13"); on this machine only mmdebstrap.
 #                --dist bookworm is this machine (Debian 12): as without --dist.
+#   --dist DIST --arch ARCH  the cross root of DIST for ARCH instead (docs/build.md,
+#                "Debian 13 on ARM"): the same packages with ARCH added as a foreign
+#                architecture, the libraries below also as LIBRARY:ARCH, DIST's cross
+#                compiler and qemu-user, in /var/cache/fieldbridge/root/DIST-cross-ARCH.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
@@ -27,7 +31,7 @@ while [ $# -gt 0 ]; do
 done
 case "$dist" in
   bookworm) ;;
-  trixie) [ ${#cross_arches[@]} -eq 0 ] || { echo "install-deps: --dist trixie is amd64 only (no --arch)" >&2; exit 2; } ;;
+  trixie) ;;
   *) echo "install-deps: no build root for Debian release '$dist' (bookworm or trixie)" >&2; exit 2 ;;
 esac
 
@@ -38,6 +42,12 @@ libraries=(
   libsystemd-dev doctest-dev nlohmann-json3-dev libasio-dev libspdlog-dev libfmt-dev
   libcli11-dev libmicrohttpd-dev libprotobuf-c-dev
 )
+# Those a target architecture needs its own of (Multi-Arch: same); the headers-only
+# ones are Architecture: all, one package for every architecture.
+arch_libraries=()
+for p in "${libraries[@]}"; do
+  case "$p" in doctest-dev|nlohmann-json3-dev|libasio-dev|libcli11-dev) ;; *) arch_libraries+=("$p") ;; esac
+done
 packages=(
   # toolchain
   build-essential cmake ninja-build g++ pkg-config
@@ -71,7 +81,8 @@ for arch in "${cross_arches[@]}"; do
   esac
   # The compiler runs here (amd64 packages); the target's libraries come from its root;
   # qemu-user runs the target's programs (the tests, --version); mmdebstrap makes the root.
-  packages+=("crossbuild-essential-$arch" qemu-user mmdebstrap)
+  # In a release's cross root all three are that release's, installed in the root.
+  [ "$dist" != bookworm ] || packages+=("crossbuild-essential-$arch" qemu-user mmdebstrap)
 done
 
 missing=()
@@ -83,11 +94,19 @@ done
 
 make_sysroots() {
   local arch
-  for arch in "${cross_arches[@]}"; do
-    "$here/deploy/cross/make-sysroot" "$arch" "${libraries[@]}"
-  done
-  if [ ${#root_packages[@]} -gt 0 ]; then
+  if [ ${#root_packages[@]} -eq 0 ]; then
+    for arch in "${cross_arches[@]}"; do
+      "$here/deploy/cross/make-sysroot" "$arch" "${libraries[@]}"
+    done
+  elif [ ${#cross_arches[@]} -eq 0 ]; then
     "$here/deploy/dist/make-root" "$dist" amd64 "${root_packages[@]}"
+  else
+    # The release's cross roots: the build root's packages, the cross compiler, the
+    # emulator, and the target's libraries (multiarch: LIBRARY:ARCH).
+    for arch in "${cross_arches[@]}"; do
+      "$here/deploy/dist/make-root" --foreign "$arch" "$dist" amd64 "${root_packages[@]}" \
+        "crossbuild-essential-$arch" qemu-user "${arch_libraries[@]/%/:$arch}"
+    done
   fi
 }
 

@@ -11,6 +11,14 @@ set(CMAKE_C_COMPILER ${FIELDBRIDGE_CROSS_TRIPLET}-gcc)
 set(CMAKE_CXX_COMPILER ${FIELDBRIDGE_CROSS_TRIPLET}-g++)
 set(CMAKE_LIBRARY_ARCHITECTURE ${FIELDBRIDGE_CROSS_TRIPLET})
 
+# In a release's cross root (deploy/dist/in-root --arch; docs/build.md, "Debian 13 on
+# ARM") the target's libraries are installed beside the machine's (multiarch): there is
+# no target root to point at.
+if("$ENV{FIELDBRIDGE_ROOT_FOREIGN_ARCH}" STREQUAL "${FIELDBRIDGE_CROSS_DEBIAN_ARCH}")
+  include(${CMAKE_CURRENT_LIST_DIR}/debian-multiarch.cmake)
+  return()
+endif()
+
 if(DEFINED ENV{FIELDBRIDGE_SYSROOT})
   set(FIELDBRIDGE_SYSROOT "$ENV{FIELDBRIDGE_SYSROOT}")
 elseif(NOT FIELDBRIDGE_SYSROOT)

@@ -17,7 +17,7 @@ namespace fieldbridge::config {
 struct PointDefaults {
     WordOrder word_order = WordOrder::high_first;
     milliseconds period = seconds{1};
-    std::uint16_t max_gap = core::PointModel{}.max_gap;
+    std::uint16_t max_gap = core::PointModel::default_max_gap;
 };
 
 [[nodiscard]] PointDefaults point_defaults(const RawDefinition* definition, const RawDevice* device);

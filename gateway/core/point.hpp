@@ -172,7 +172,8 @@ struct PointModel {
     std::vector<PointDef> points;
     std::vector<AlarmRule> alarms;
     /// Registers (bits) that no point names which a merged read may bridge.
-    std::uint16_t max_gap = 8;
+    static constexpr std::uint16_t default_max_gap = 8;
+    std::uint16_t max_gap = default_max_gap;
     bool operator==(const PointModel&) const = default;
 };
 

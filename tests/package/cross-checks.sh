@@ -1,15 +1,22 @@
 # The checks of tests/package/test-package.sh --arch ARCH on packages cross-built for
 # ARCH (arm64, armhf), which this machine cannot install: sourced by test-package.sh
 # after its common checks, with its helpers (check, contains) and $here, $out,
-# $version, $arch, $native, $deb, $sim_deb set.
+# $version, $arch, $native, $deb, $sim_deb set. Run on this machine (Debian 12) or, for
+# a release's packages (--dist trixie --arch), inside that release's cross root.
 
-sysroot="${FIELDBRIDGE_SYSROOT:-$("$here/deploy/cross/make-sysroot" --path "$arch")}"
 case "$arch" in
   arm64) qemu=qemu-aarch64; elf='Class: +ELF64.*Machine: +AArch64' ;;
   armhf) qemu=qemu-arm; elf='Class: +ELF32.*Machine: +ARM.*Flags: .*hard-float' ;;
   *) echo "test-package: no cross checks for '$arch' (arm64 or armhf)" >&2; exit 2 ;;
 esac
-emulator=("$qemu" -L "$sysroot")
+if [ -n "${FIELDBRIDGE_IN_ROOT:-}" ]; then
+  # A release's cross root (deploy/dist/in-root --arch): the target's loader and
+  # libraries are installed there (multiarch), where the programs look for them.
+  emulator=("$qemu")
+else
+  sysroot="${FIELDBRIDGE_SYSROOT:-$("$here/deploy/cross/make-sysroot" --path "$arch")}"
+  emulator=("$qemu" -L "$sysroot")
+fi
 
 # This machine's packages: what the cross-built ones must hold, and the simulator the
 # packaged daemon is tested against.

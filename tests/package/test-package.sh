@@ -30,7 +30,15 @@
 # copy each run; tests/package/clean-root-checks.sh): apt resolves their Depends from
 # Debian 13 alone, and the packaged fieldbridge checks its packaged configuration there.
 #
-# Usage: tests/package/test-package.sh [--arch ARCH | --dist DIST]
+# With --dist trixie --arch arm64 or armhf, the Debian 13 packages for that architecture
+# (deploy/build-deb --dist trixie --arch, built in the Debian 13 cross root): the --arch
+# checks above run inside that cross root (Debian 13's lintian and qemu-user, compared
+# with the Debian 13 amd64 packages), then the packages are installed by apt into a
+# clean Debian 13 root of this machine's architecture with ARCH added (multiarch), where
+# apt resolves their Depends from Debian 13's ARCH packages alone and the installed
+# programs run under qemu-user (tests/package/clean-root-checks.sh).
+#
+# Usage: tests/package/test-package.sh [--dist DIST] [--arch ARCH]
 #   FIELDBRIDGE_DEB_DIR        where the packages are built (default build-deb/)
 #   FIELDBRIDGE_DEB_PREBUILT=1 test the packages already in that directory, no build
 set -euo pipefail
@@ -39,14 +47,17 @@ out="${FIELDBRIDGE_DEB_DIR:-$here/build-deb}"
 export FIELDBRIDGE_DEB_DIR="$out"
 native="$(dpkg --print-architecture)"
 arch="$native" dist=bookworm
-case "${1:-}" in
-  --arch) [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
-          arch="$2" ;;
-  --dist) [ $# -ge 2 ] || { echo "test-package: --dist needs a Debian release (bookworm or trixie)" >&2; exit 2; }
-          dist="$2" ;;
-esac
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --arch) [ $# -ge 2 ] || { echo "test-package: --arch needs an architecture" >&2; exit 2; }
+            arch="$2"; shift 2 ;;
+    --dist) [ $# -ge 2 ] || { echo "test-package: --dist needs a Debian release (bookworm or trixie)" >&2; exit 2; }
+            dist="$2"; shift 2 ;;
+    *) echo "test-package: unknown argument '$1' (usage: test-package.sh [--dist bookworm|trixie] [--arch $native|arm64|armhf])" >&2; exit 2 ;;
+  esac
+done
 build_args=(--arch "$arch") build_name="$arch"
-if [ "$dist" != bookworm ]; then build_args=(--dist "$dist") build_name="$dist-$arch"; fi
+if [ "$dist" != bookworm ]; then build_args=(--dist "$dist" --arch "$arch") build_name="$dist-$arch"; fi
 
 started=$SECONDS
 if [ "${FIELDBRIDGE_DEB_PREBUILT:-0}" != 1 ]; then
@@ -83,9 +94,13 @@ contains() {  # contains TEXT PATTERN: grep -E PATTERN in TEXT, TEXT shown when 
 lacks() { ! grep -Eq -- "$2" <<<"$1" || { printf '/%s/ found in:\n%s\n' "$2" "$1"; return 1; }; }
 
 if [ "$dist" != bookworm ] && [ -z "${FIELDBRIDGE_IN_ROOT:-}" ]; then
-  # The checks below inside the release's build root, then the clean root's.
-  FIELDBRIDGE_DEB_PREBUILT=1 "$here/deploy/dist/in-root" "$dist" "$here/tests/package/test-package.sh"
-  version="$("$here/deploy/dist/in-root" "$dist" "$here/deploy/package-version")"
+  # The checks below inside the release's build root (for arm64 and armhf its cross
+  # root, with the cross checks), then the clean root's.
+  root_args=()
+  [ "$arch" = "$native" ] || root_args=(--arch "$arch")
+  FIELDBRIDGE_DEB_PREBUILT=1 "$here/deploy/dist/in-root" "${root_args[@]}" "$dist" \
+    "$here/tests/package/test-package.sh" "${root_args[@]}"
+  version="$("$here/deploy/dist/in-root" "${root_args[@]}" "$dist" "$here/deploy/package-version")"
   deb="$out/fieldbridge_${version}_${arch}.deb"
   sim_deb="$out/fieldbridge-sim_${version}_${arch}.deb"
   upstream_version="${version%%~*}"
