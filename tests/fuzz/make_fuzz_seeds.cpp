@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -148,14 +149,32 @@ void sparkplug_seeds(const fs::path& out) {
         commands.write(text_bytes(bytes));
     };
     using T = sp::DataType;
-    write({{{"Node Control/Rebirth", std::nullopt}, T::boolean, true}});
-    write({{{std::nullopt, 4}, T::uint16, std::uint64_t{80}}});
-    write({{{std::nullopt, 4}, std::nullopt, std::uint64_t{80}}});
-    write({{{"force_pct", std::nullopt}, T::int16, static_cast<std::uint64_t>(-5)}});
-    write({{{"setpoint", 9}, T::float32, 12.5f},
-           {{"ratio", std::nullopt}, T::float64, 0.25},
-           {{"label", std::nullopt}, T::string, std::string("tool 2")},
-           {{std::nullopt, 11}, T::int64, static_cast<std::uint64_t>(-1)}});
+    // Built one by one: GCC 12 at -O3 (the arm64 cross build) warns a false
+    // -Wmaybe-uninitialized on optionals destroyed in a braced list of temporaries.
+    const auto metric = [](std::optional<std::string> name, std::optional<std::uint64_t> alias,
+                           std::optional<T> type, sp::Value value) {
+        sp::CommandMetric m;
+        m.metric.name = std::move(name);
+        m.metric.alias = alias;
+        m.datatype = type;
+        m.value = std::move(value);
+        return m;
+    };
+    const auto one = [&write](sp::CommandMetric m) {
+        std::vector<sp::CommandMetric> metrics;
+        metrics.push_back(std::move(m));
+        write(std::move(metrics));
+    };
+    one(metric("Node Control/Rebirth", std::nullopt, T::boolean, true));
+    one(metric(std::nullopt, 4, T::uint16, std::uint64_t{80}));
+    one(metric(std::nullopt, 4, std::nullopt, std::uint64_t{80}));
+    one(metric("force_pct", std::nullopt, T::int16, static_cast<std::uint64_t>(-5)));
+    std::vector<sp::CommandMetric> several;
+    several.push_back(metric("setpoint", 9, T::float32, 12.5f));
+    several.push_back(metric("ratio", std::nullopt, T::float64, 0.25));
+    several.push_back(metric("label", std::nullopt, T::string, std::string("tool 2")));
+    several.push_back(metric(std::nullopt, 11, T::int64, static_cast<std::uint64_t>(-1)));
+    write(std::move(several));
     std::cout << "make_fuzz_seeds: " << commands.count() << " Sparkplug command seeds\n";
 }
 
