@@ -7,6 +7,7 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/points/point_alarms.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/device_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/operations.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/field_setters.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/poll_plan.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/register_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/modbus_profile.cpp

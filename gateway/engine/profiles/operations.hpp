@@ -111,6 +111,19 @@ struct OperationSet {
     [[nodiscard]] const Operation* find(std::string_view op) const noexcept;
 };
 
+/// A state field that one operation sets by itself: writing the field (a Sparkplug
+/// DCMD, docs/sparkplug.md "Commands") is the operation @c op with the value as its
+/// field @c argument. E.g. the WTEC `force_pct` is op `force` with `percent`.
+struct FieldSetter {
+    std::string_view field;
+    std::string_view op;
+    std::string_view argument;
+};
+
+/// The fields of @p operations' device type that an operation sets (static storage);
+/// empty for a type with none.
+[[nodiscard]] std::span<const FieldSetter> field_setters(const OperationSet& operations) noexcept;
+
 // ---- helpers for the tables -----------------------------------------------------
 
 /// One FC06.

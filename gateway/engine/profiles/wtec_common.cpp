@@ -85,6 +85,15 @@ template <std::uint16_t Address>
 
 OperationSet wtec_operations() { return OperationSet{"wtec", wtec_operation_table()}; }
 
+std::span<const FieldSetter> wtec_field_setters() noexcept {
+    static constexpr FieldSetter setters[] = {
+        {"target_pct", "position", "percent"},
+        {"force_pct", "force", "percent"},
+        {"speed_pct", "speed", "percent"},
+    };
+    return setters;
+}
+
 std::string_view wtec_init_state_name(std::uint16_t value) noexcept {
     switch (value) {
         case wtec_reg::init_not_done: return "not_initialized";

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -86,6 +87,9 @@ namespace fieldbridge::engine {
 /// grip, release, position, force, speed, estop on the uniform map. grip and release
 /// read the init direction (0x0300) from the registers they are given.
 [[nodiscard]] OperationSet wtec_operations();
+/// The state fields an op of wtec_operations() sets alone: target_pct (position),
+/// force_pct (force), speed_pct (speed).
+[[nodiscard]] std::span<const FieldSetter> wtec_field_setters() noexcept;
 
 /// Seed 003 table 2.4: "not_initialized", "initialized", "failed", "initializing".
 [[nodiscard]] std::string_view wtec_init_state_name(std::uint16_t value) noexcept;
