@@ -35,7 +35,7 @@ SourceState image_state(const engine::DeviceProfile& profile, const engine::Regi
     return s;
 }
 
-AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool commands_enabled)
+AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool commands_enabled, bool notices)
     : io_(io),
       agent_(&agent),
       name_(agent.config().name),
@@ -43,6 +43,7 @@ AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool 
                                               : agent.config().type_name),
       operations_(agent.profile().operations()),
       commands_enabled_(commands_enabled),
+      notices_(notices),
       listener_(std::make_shared<SourceListener>()) {
     if (const auto* modbus = dynamic_cast<const engine::ModbusProfile*>(&agent.profile())) {
         points_ = modbus->options().points;
@@ -51,15 +52,17 @@ AgentSource::AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool 
     subscription_ = agent.image().subscribe([weak](const engine::ImageChange&) {
         if (auto l = weak.lock(); l && l->changed) l->changed();
     });
-    agent.set_notice_callback([weak](const engine::DeviceNotice& notice) {
-        if (auto l = weak.lock(); l && l->notice) l->notice(notice);
-    });
+    if (notices_) {
+        agent.set_notice_callback([weak](const engine::DeviceNotice& notice) {
+            if (auto l = weak.lock(); l && l->notice) l->notice(notice);
+        });
+    }
 }
 
 AgentSource::~AgentSource() {
     if (agent_ != nullptr) {
         (void)agent_->image().unsubscribe(subscription_);
-        agent_->set_notice_callback({});
+        if (notices_) agent_->set_notice_callback({});
     }
 }
 
@@ -77,6 +80,26 @@ SourceState AgentSource::state() const {
         return s;
     }
     return image_state(agent_->profile(), agent_->image(), agent_->online());
+}
+
+engine::DecodedState AgentSource::shape() const {
+    if (agent_ == nullptr) return {};
+    // The built-in types' registers all lie in the first 8192 of each table
+    // (docs/registers.md); a device with points has its fields from its points.
+    constexpr std::size_t span = 8192;
+    std::vector<std::uint16_t> words(span);
+    std::vector<std::uint16_t> bits(span);
+    for (std::size_t i = 0; i < span; ++i) {
+        words[i] = static_cast<std::uint16_t>((i * 37 + 11) % 1000);
+        bits[i] = static_cast<std::uint16_t>(i % 2);
+    }
+    engine::RegisterImage image;
+    const engine::TimePoint now = engine::Clock::now();
+    image.update(engine::Table::holding, 0, words, now);
+    image.update(engine::Table::input, 0, words, now);
+    image.update(engine::Table::coils, 0, bits, now);
+    image.update(engine::Table::discrete_inputs, 0, bits, now);
+    return image_state(agent_->profile(), image, true).decoded;
 }
 
 std::vector<engine::Alarm> AgentSource::alarms() const {

@@ -19,7 +19,9 @@ namespace fieldbridge::northbound::mqtt {
 
 class AgentSource final : public DeviceSource {
 public:
-    AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool commands_enabled);
+    /// @p notices: take the agent's notice callback (one taker per agent: the JSON
+    /// bridge's source; the Sparkplug node's sources do without notices).
+    AgentSource(asio::io_context& io, engine::DeviceAgent& agent, bool commands_enabled, bool notices = true);
     ~AgentSource() override;
 
     [[nodiscard]] const std::string& name() const override { return name_; }
@@ -31,6 +33,9 @@ public:
     }
     [[nodiscard]] bool commands_enabled() const override { return commands_enabled_; }
     [[nodiscard]] SourceState state() const override;
+    /// The profile's decoding of an image with every register of the device's address
+    /// range known (varying values, so that no field is left out for a zero).
+    [[nodiscard]] engine::DecodedState shape() const override;
     [[nodiscard]] std::vector<engine::Alarm> alarms() const override;
     void set_listener(SourceListener listener) override;
     [[nodiscard]] std::optional<protocol::ExceptionCode> validate(const protocol::Request& request) const override;
@@ -47,6 +52,7 @@ private:
     engine::OperationSet operations_;
     core::PointModel points_;  ///< kept: valid after detach()
     bool commands_enabled_;
+    bool notices_;
     engine::RegisterImage::SubscriptionId subscription_ = 0;
     // Shared with the image's listener and the notice callback, which the engine
     // may call after this source is gone (it holds them, not the other way round).

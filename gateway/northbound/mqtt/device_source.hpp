@@ -61,6 +61,10 @@ public:
     [[nodiscard]] virtual bool commands_enabled() const = 0;
 
     [[nodiscard]] virtual SourceState state() const = 0;
+    /// Every field its state can have, with placeholder values (what the device's
+    /// metrics are before its registers are read: the Sparkplug node births it once,
+    /// not once per register block that comes in). Default: the current state's.
+    [[nodiscard]] virtual engine::DecodedState shape() const { return state().decoded; }
     [[nodiscard]] virtual std::vector<engine::Alarm> alarms() const = 0;
 
     /// Replaces the listener; an empty one stops the reports.

@@ -48,6 +48,11 @@ public:
     /// connected, library refused): nothing will be reported for it then.
     [[nodiscard]] virtual std::uint64_t publish(const Message& message) = 0;
     virtual void subscribe(const std::string& filter, int qos) = 0;
+    /// Ends a subscription (a device removed by a reload); nothing when not connected.
+    virtual void unsubscribe(const std::string& filter) { static_cast<void>(filter); }
+    /// The will of the next connect() from now on, replacing the one the client was
+    /// made with (the Sparkplug NDEATH carries the connection's bdSeq).
+    virtual void set_will(const Message& will) { static_cast<void>(will); }
     /// A clean disconnect (no will), waiting at most @p timeout for what is in flight;
     /// @p done runs on the loop thread afterwards, whatever happened.
     virtual void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) = 0;

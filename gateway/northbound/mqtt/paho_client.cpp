@@ -358,6 +358,16 @@ void PahoClient::subscribe(const std::string& filter, int qos) {
     }
 }
 
+void PahoClient::unsubscribe(const std::string& filter) {
+    try {
+        if (core_->client_->is_connected()) core_->client_->unsubscribe(filter);
+    } catch (const std::exception&) {
+        // Lost the connection meanwhile: the next session does not subscribe it.
+    }
+}
+
+void PahoClient::set_will(const Message& will) { core_->options_.will = will; }
+
 void PahoClient::disconnect(std::chrono::milliseconds timeout, std::function<void()> done) {
     const std::uint64_t id = core_->next_id_++;
     try {

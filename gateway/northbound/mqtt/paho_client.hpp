@@ -69,6 +69,8 @@ public:
     void connect() override;
     [[nodiscard]] std::uint64_t publish(const Message& message) override;
     void subscribe(const std::string& filter, int qos) override;
+    void unsubscribe(const std::string& filter) override;
+    void set_will(const Message& will) override;
     void disconnect(std::chrono::milliseconds timeout, std::function<void()> done) override;
     [[nodiscard]] bool connected() const override;
     [[nodiscard]] std::size_t server_count() const override;

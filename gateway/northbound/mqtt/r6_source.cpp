@@ -1,6 +1,7 @@
 #include "northbound/mqtt/r6_source.hpp"
 
 #include <map>
+#include <vector>
 #include <utility>
 
 #include <asio/post.hpp>
@@ -21,7 +22,8 @@ constexpr std::uint64_t mqtt_connection = 0xFFFF'FFFF'FFFF'FF00ULL;
 /// Shared by the sources of one target: the target's one state callback fans out.
 struct Hub {
     upstream::UpstreamTarget* target = nullptr;
-    std::map<core::UnitId, std::shared_ptr<SourceListener>> listeners;
+    /// Several per unit: one source per consumer (the JSON bridge, the Sparkplug node).
+    std::multimap<core::UnitId, std::shared_ptr<SourceListener>> listeners;
 };
 
 class R6Source final : public DeviceSource {
@@ -29,9 +31,17 @@ public:
     R6Source(asio::io_context& io, std::shared_ptr<Hub> hub, const config::UpstreamUnitConfig& unit)
         : io_(io), hub_(std::move(hub)), unit_(unit.unit_id), name_(unit.name),
           listener_(std::make_shared<SourceListener>()) {
-        hub_->listeners[unit_] = listener_;
+        hub_->listeners.emplace(unit_, listener_);
     }
-    ~R6Source() override { hub_->listeners.erase(unit_); }
+    ~R6Source() override {
+        const auto [first, last] = hub_->listeners.equal_range(unit_);
+        for (auto it = first; it != last; ++it) {
+            if (it->second == listener_) {
+                hub_->listeners.erase(it);
+                break;
+            }
+        }
+    }
 
     const std::string& name() const override { return name_; }
     std::string_view type() const override { return "r6"; }
@@ -113,21 +123,26 @@ private:
 
 }  // namespace
 
-std::vector<std::shared_ptr<DeviceSource>> make_r6_sources(asio::io_context& io, upstream::UpstreamTarget& target) {
+std::vector<std::shared_ptr<DeviceSource>> make_r6_sources(asio::io_context& io, upstream::UpstreamTarget& target,
+                                                           std::size_t copies) {
     auto hub = std::make_shared<Hub>();
     hub->target = &target;
     target.set_state_callback([weak = std::weak_ptr<Hub>(hub)](const upstream::R6State& state) {
         const auto h = weak.lock();
         if (!h) return;
-        const auto it = h->listeners.find(state.unit_id);
-        if (it == h->listeners.end()) return;
-        // Copied: the listener may replace itself.
-        const auto listener = it->second;
-        if (listener->changed) listener->changed();
+        // Copied: a listener may replace itself or go.
+        std::vector<std::shared_ptr<SourceListener>> listeners;
+        const auto [first, last] = h->listeners.equal_range(state.unit_id);
+        for (auto it = first; it != last; ++it) listeners.push_back(it->second);
+        for (const auto& listener : listeners) {
+            if (listener->changed) listener->changed();
+        }
     });
     std::vector<std::shared_ptr<DeviceSource>> sources;
-    for (const config::UpstreamUnitConfig& unit : target.config().units) {
-        sources.push_back(std::make_shared<R6Source>(io, hub, unit));
+    for (std::size_t copy = 0; copy < copies; ++copy) {
+        for (const config::UpstreamUnitConfig& unit : target.config().units) {
+            sources.push_back(std::make_shared<R6Source>(io, hub, unit));
+        }
     }
     return sources;
 }

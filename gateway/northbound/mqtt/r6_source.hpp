@@ -10,6 +10,7 @@
 /// The target's state callback is taken over (one per target). The target must
 /// outlive the sources or be detached from them first (detach_r6_sources()). Loop
 /// thread only.
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -18,9 +19,12 @@
 
 namespace fieldbridge::northbound::mqtt {
 
-/// One source per unit of @p target's configuration.
+/// One source per unit of @p target's configuration, @p copies times (unit order within
+/// each copy): one copy per consumer (each source has its own listener), all fed by the
+/// target's one state callback, which this takes over.
 [[nodiscard]] std::vector<std::shared_ptr<DeviceSource>> make_r6_sources(asio::io_context& io,
-                                                                         upstream::UpstreamTarget& target);
+                                                                         upstream::UpstreamTarget& target,
+                                                                         std::size_t copies = 1);
 /// The target is going away: the sources report offline and answer commands 0x0A.
 void detach_r6_sources(const std::vector<std::shared_ptr<DeviceSource>>& sources);
 

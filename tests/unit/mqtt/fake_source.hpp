@@ -1,6 +1,7 @@
 #pragma once
 // A DeviceSource driven by the test: its state, alarms and the answers to commands.
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ public:
     fe::OperationSet operations() const override { return operations_; }
     bool commands_enabled() const override { return commands_enabled_; }
     fm::SourceState state() const override { return state_; }
+    fe::DecodedState shape() const override { return shape_ ? *shape_ : state_.decoded; }
     std::vector<fe::Alarm> alarms() const override { return alarms_; }
     void set_listener(fm::SourceListener listener) override { listener_ = std::move(listener); }
     std::optional<fp::ExceptionCode> validate(const fp::Request& request) const override {
@@ -60,6 +62,11 @@ public:
         state_.updated = fe::Clock::now();
         changed();
     }
+    /// Replaces the decoded fields (another device type's state).
+    void set_fields(std::vector<fe::Field> fields) {
+        state_.decoded.fields = std::move(fields);
+        changed();
+    }
     /// Adds a register to the raw image (e.g. a WTEC's init direction, holding 0x0300).
     void add_register(fm::RawRegister r) {
         state_.raw.push_back(r);
@@ -78,6 +85,7 @@ public:
         if (listener_.changed) listener_.changed();
     }
 
+    std::optional<fe::DecodedState> shape_;  ///< what shape() says; default: the state's fields
     std::vector<fp::Request> executed;
     std::deque<fp::Response> answers;  ///< next answers to execute(); default: a write echo
     bool commands_enabled_ = true;
