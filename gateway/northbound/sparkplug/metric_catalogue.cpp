@@ -67,6 +67,18 @@ bool is_integer(DataType type) {
 
 const std::vector<CatalogueMetric> no_metrics;
 
+DataType argument_datatype(const engine::FieldType& type) {
+    return std::visit(
+        [](const auto& t) {
+            using T = std::decay_t<decltype(t)>;
+            if constexpr (std::is_same_v<T, engine::NumberField>) return DataType::float64;
+            if constexpr (std::is_same_v<T, engine::IntegerField>) return DataType::int64;
+            if constexpr (std::is_same_v<T, engine::BooleanField>) return DataType::boolean;
+            return DataType::string;  // ChoiceField
+        },
+        type);
+}
+
 }  // namespace
 
 DataType point_datatype(const core::PointDef& point) {
@@ -133,6 +145,19 @@ bool MetricCatalogue::add_device(const DeviceShape& shape) {
         add_metric(device, shape.name,
                    CatalogueMetric{field.name, field.name, std::nullopt, 0, value_datatype(field.value), field.unit,
                                    writable, nullptr});
+    }
+    // Then the type's operations (they never depend on the state).
+    for (const engine::Operation& op : shape.operations.operations) {
+        const std::string trigger = std::string(commands_folder) + std::string(op.name);
+        add_metric(device, shape.name,
+                   CatalogueMetric{trigger, "", std::nullopt, 0, DataType::boolean, "", true, nullptr,
+                                   std::string(op.name), ""});
+        for (const engine::OperationField& field : op.fields) {
+            add_metric(device, shape.name,
+                       CatalogueMetric{trigger + "/" + std::string(field.name), "", std::nullopt, 0,
+                                       argument_datatype(field.type), "", true, nullptr, std::string(op.name),
+                                       std::string(field.name)});
+        }
     }
     return device.metrics.size() != before;
 }

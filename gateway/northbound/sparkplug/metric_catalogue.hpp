@@ -38,7 +38,14 @@ struct DeviceShape {
     std::set<std::string, std::less<>> writable_fields;  ///< fields without a point that are writable
     /// Smallest change published per field (`mqtt.deadband`); a point's own deadband wins.
     std::map<std::string, double, std::less<>> deadband;
+    /// Its type's operations: each becomes the command metrics `Commands/<op>` (Boolean,
+    /// a DCMD of true runs it) and `Commands/<op>/<field>` per field (docs/sparkplug.md,
+    /// "Commands").
+    engine::OperationSet operations{};
 };
+
+/// The folder of the command metrics.
+inline constexpr std::string_view commands_folder = "Commands/";
 
 /// One metric of a device.
 struct CatalogueMetric {
@@ -50,6 +57,11 @@ struct CatalogueMetric {
     std::string unit;
     bool writable = false;
     const core::PointDef* point = nullptr;  ///< the point behind it, if any
+    /// A command metric: the operation (empty for a state metric) and, for a
+    /// parameter, the operation's field (empty for `Commands/<op>` itself).
+    std::string op{};
+    std::string argument{};
+    [[nodiscard]] bool is_command() const noexcept { return !op.empty(); }
 };
 
 class MetricCatalogue {
@@ -66,7 +78,8 @@ public:
     void remove_device(std::string_view device);
 
     /// The device's metrics in birth order (points first, in the model's order, then the
-    /// other fields in the state's order); empty for an unknown device.
+    /// other fields in the state's order, then the command metrics); empty for an
+    /// unknown device.
     [[nodiscard]] const std::vector<CatalogueMetric>& metrics(std::string_view device) const;
 
     /// False when @p state has a field the catalogue has no metric for (add_device()
