@@ -16,6 +16,7 @@
 #include "app/modbus_tcp_component.hpp"
 #include "app/mqtt_component.hpp"
 #include "app/scan_command.hpp"
+#include "app/sparkplug_component.hpp"
 #include "config/config_loader.hpp"
 #include "daemon/check_config.hpp"
 #include "daemon/command_line.hpp"
@@ -88,21 +89,35 @@ using namespace fieldbridge;
     // MQTT last among the components: stopped first, so `offline` goes out while the
     // lines still run.
     app::MqttComponent mqtt(gateway.context(), logger, [&engine] { return engine.engine(); });
-    std::vector<std::shared_ptr<northbound::mqtt::DeviceSource>> r6_sources;
-    mqtt.add_sources([&] {
-        northbound::mqtt::detach_r6_sources(r6_sources);
-        r6_sources.clear();
+    // The R6 units as device sources: one copy for the JSON bridge, one for the Sparkplug
+    // node (each source has one listener), rebuilt when the upstream targets change.
+    struct R6Sources {
+        std::vector<const void*> targets;  ///< the upstream targets they were made for
+        std::vector<std::shared_ptr<northbound::mqtt::DeviceSource>> all, json, sparkplug;
+    } r6;
+    const auto r6_detach = [&r6] {
+        northbound::mqtt::detach_r6_sources(r6.all);
+        r6 = R6Sources{};
+    };
+    const auto r6_ensure = [&] {
+        std::vector<const void*> targets;
+        for (const auto& upstream : modbus_tcp.upstreams()) targets.push_back(upstream.get());
+        if (targets == r6.targets && !r6.all.empty()) return;
+        r6_detach();
+        r6.targets = std::move(targets);
         for (const auto& upstream : modbus_tcp.upstreams()) {
-            for (auto& source : northbound::mqtt::make_r6_sources(gateway.context(), *upstream)) {
-                r6_sources.push_back(std::move(source));
-            }
+            auto made = northbound::mqtt::make_r6_sources(gateway.context(), *upstream, 2);
+            const std::size_t half = made.size() / 2;
+            r6.json.insert(r6.json.end(), made.begin(), made.begin() + static_cast<std::ptrdiff_t>(half));
+            r6.sparkplug.insert(r6.sparkplug.end(), made.begin() + static_cast<std::ptrdiff_t>(half), made.end());
+            r6.all.insert(r6.all.end(), made.begin(), made.end());
         }
-        return r6_sources;
+    };
+    mqtt.add_sources([&] {
+        r6_ensure();
+        return r6.json;
     });
-    modbus_tcp.on_upstreams_closing([&r6_sources] {
-        northbound::mqtt::detach_r6_sources(r6_sources);
-        r6_sources.clear();
-    });
+    modbus_tcp.on_upstreams_closing(r6_detach);
     mqtt.add_diag([&modbus_tcp] {
         nlohmann::json diag = nlohmann::json::object();
         if (const auto* server = modbus_tcp.server()) {
@@ -120,6 +135,22 @@ using namespace fieldbridge;
     });
     gateway.add_component(mqtt);
     gateway.add_status([&mqtt] { return mqtt.status(); });
+    // The Sparkplug B edge node after MQTT: stopped first, its NDEATH out while the lines run.
+    app::SparkplugComponent sparkplug(
+        gateway.context(), logger, [&engine] { return engine.engine(); }, FIELDBRIDGE_VERSION,
+        [&modbus_tcp, &mqtt](northbound::sparkplug_node::NodeSnapshot& snapshot) {
+            const std::string status = mqtt.status();
+            snapshot.json_bridge = status == "MQTT connected" ? "connected" : status == "MQTT off" ? "off" : "connecting";
+            for (const auto& upstream : modbus_tcp.upstreams()) {
+                snapshot.upstreams.push_back({upstream->config().name, northbound::upstream::to_string(upstream->link_state())});
+            }
+        });
+    sparkplug.add_sources([&] {
+        r6_ensure();
+        return r6.sparkplug;
+    });
+    gateway.add_component(sparkplug);
+    gateway.add_status([&sparkplug] { return sparkplug.status(); });
     // Prometheus metrics (off without metrics_http): each collector asks its component
     // at scrape time, so a rebuilt engine or server is simply what the next scrape sees.
     namespace metrics = northbound::metrics;

@@ -21,8 +21,8 @@ std::string describe_inventory(const config::Config& config) {
 std::string describe_config(const config::Config& config) {
     std::string text = describe_inventory(config) + (config.mqtt.enabled ? ", MQTT enabled" : ", MQTT disabled");
     if (config.sparkplug) {
-        text += ", Sparkplug B configured (group " + config.sparkplug->group_id + ", edge node " +
-                config.sparkplug->edge_node_id + "; not yet active)";
+        text += ", Sparkplug B enabled (group " + config.sparkplug->group_id + ", edge node " +
+                config.sparkplug->edge_node_id + ")";
     }
     return text;
 }

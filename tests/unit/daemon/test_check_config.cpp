@@ -61,7 +61,7 @@ TEST_CASE("the summary names the Sparkplug group and edge node when the section 
     built->sparkplug->group_id = "plant1";
     built->sparkplug->edge_node_id = "gw-7";
     CHECK(daemon_ns::describe_config(*built) ==
-          "1 line, 0 devices, MQTT disabled, Sparkplug B configured (group plant1, edge node gw-7; not yet active)");
+          "1 line, 0 devices, MQTT disabled, Sparkplug B enabled (group plant1, edge node gw-7)");
 }
 
 TEST_CASE("a valid file: one line on stdout, exit 0") {
