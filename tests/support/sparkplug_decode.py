@@ -12,7 +12,14 @@ from the gateway. A test host (part C) imports it:
     payload = decoder.decode(raw_bytes)          # a dict, see decode()
     raw = decoder.encode({"metrics": [...]})     # a host's NCMD/DCMD
 
-As a program: sparkplug_decode.py FILE... prints each payload as JSON.
+As a program: sparkplug_decode.py FILE... prints each payload as JSON; with --lines it
+reads `TOPIC HEX` lines from standard input (mosquitto_sub -F '%t %x') and prints one JSON
+object per message, so a user can watch an edge node:
+
+    mosquitto_sub -t 'spBv1.0/#' -F '%t %x' | python3 tests/support/sparkplug_decode.py --lines
+
+and with --encode JSON it writes a host's NCMD/DCMD payload (JSON as decode() prints it)
+to standard output, for `mosquitto_pub -s`.
 """
 
 import importlib.util
@@ -179,11 +186,35 @@ def _printable(value):
     return value
 
 
+def _watch(decoder, lines, out):
+    """Decodes `TOPIC HEX` lines; a line that is not one is reported, not fatal."""
+    for line in lines:
+        topic, _, payload = line.rstrip("\n").rpartition(" ")
+        if not topic:
+            topic, payload = payload, ""
+        try:
+            decoded = decoder.decode(bytes.fromhex(payload))
+            for metric in decoded["metrics"]:
+                metric["value"] = _printable(metric["value"])
+            record = {"topic": topic, **decoded}
+        except Exception as e:  # noqa: BLE001 - a watcher reports any bad message and goes on
+            record = {"topic": topic, "error": str(e)}
+        out.write(json.dumps(record) + "\n")
+        out.flush()
+
+
 def main(argv):
     if len(argv) < 2:
-        print("usage: sparkplug_decode.py FILE...", file=sys.stderr)
+        print("usage: sparkplug_decode.py FILE... | --lines | --encode JSON", file=sys.stderr)
         return 2
     decoder = SparkplugDecoder()
+    if argv[1] == "--lines":
+        _watch(decoder, sys.stdin, sys.stdout)
+        return 0
+    if argv[1] == "--encode" and len(argv) == 3:
+        # A host's command: the payload as JSON (as decode() prints it) to bytes on stdout.
+        sys.stdout.buffer.write(decoder.encode(json.loads(argv[2])))
+        return 0
     for name in argv[1:]:
         decoded = decoder.decode(pathlib.Path(name).read_bytes())
         for metric in decoded["metrics"]:
