@@ -1,6 +1,7 @@
 #include "northbound/sparkplug_node/edge_node.hpp"
 
 #include <algorithm>
+#include <span>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -135,10 +136,9 @@ sparkplug::DeviceShape EdgeNode::shape_of(const mqtt::DeviceSource& source, cons
     shape.state = state;
     shape.deadband = settings_.deadband;
     if (source.commands_enabled()) {
-        for (const engine::FieldSetter& setter : engine::field_setters(source.operations())) {
-            shape.writable_fields.insert(std::string(setter.field));
-        }
         shape.operations = source.operations();
+        const std::span<const engine::FieldSetter> setters = engine::field_setters(shape.operations);
+        for (const engine::FieldSetter& setter : setters) shape.writable_fields.insert(std::string(setter.field));
     }
     return shape;
 }
@@ -497,8 +497,9 @@ void EdgeNode::on_dcmd(Device& device, const std::string& payload) {
     if (running_commands_ >= settings_.max_running_commands) {
         return refuse(what, std::to_string(running_commands_) + " DCMDs are still being executed; send it again later");
     }
+    const engine::OperationSet operations = source.operations();
     DcmdPlan plan = plan_dcmd(catalogue_, source.name(), *decoded.command, device.arguments,
-                              engine::field_setters(source.operations()));
+                              engine::field_setters(operations));
     if (!plan.ok()) return refuse(what, plan.error);
     // Every command parsed and checked before anything is sent: all or nothing.
     const mqtt::SourceState state = source.state();
