@@ -565,8 +565,8 @@ double ratio(double a, double b) { return b != 0.0 ? a / b : 0.0; }
 int run(const Options& options) {
     const bench::LoadShape shape(bench::LoadShape::Kind::generic);
     const bench::LineLimit limit = bench::line_limit(shape, options.baud, turnaround);
-    char work_template[] = "/tmp/fb-spb-bench-XXXXXX";
-    if (mkdtemp(work_template) == nullptr) throw std::runtime_error("mkdtemp failed");
+    std::string work_template = "/tmp/fb-spb-bench-" + std::string(6, 'X');  // mkdtemp's template
+    if (mkdtemp(work_template.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
     const std::filesystem::path work = work_template;
     std::filesystem::create_directories(work / "state");
     std::ofstream(work / "bench50.yaml") << definition_yaml();
