@@ -174,6 +174,10 @@ class Process:
         with self._condition:
             return "\n".join(line for line in self.lines if line is not None)
 
+    def report(self):
+        """What a failed test prints of this process: its log."""
+        return _read(self.log_path)
+
     def wait_line(self, predicate, timeout, start=0):
         """Index and text of the first line from `start` on that satisfies predicate,
         or None at the deadline or end of stream."""
@@ -343,8 +347,12 @@ class CellTestCase(unittest.TestCase):
         for client in self.clients:
             client.close()
         result = getattr(getattr(self, "_outcome", None), "result", None)
-        failed = result is not None and any(
-            test is self for test, _ in list(result.failures) + list(result.errors))
+        failures = [] if result is None else [
+            text for test, text in list(result.failures) + list(result.errors) if test is self]
+        failed = bool(failures)
+        if failed:
+            # The failure first: CI keeps the head and the tail of a long output.
+            sys.stderr.write("---- %s failed ----\n%s\n" % (self.id(), failures[-1]))
         # The gateway and the simulator still running are stopped with SIGTERM and must
         # exit 0, so that a sanitizer build's leak and shutdown checks count.
         unclean = []
@@ -368,7 +376,7 @@ class CellTestCase(unittest.TestCase):
                         unclean.append("fieldbridge ignored SIGTERM for %.0f s" % STOP_TIMEOUT)
             process.kill()
             if failed or unclean:
-                sys.stderr.write("---- %s log ----\n%s\n" % (process.name, _read(process.log_path)))
+                sys.stderr.write("---- %s log ----\n%s\n" % (process.name, process.report()))
         if self.sim is not None:
             if self.sim.proc.poll() is None:
                 try:

@@ -118,6 +118,10 @@ class SparkplugSubscriber(gatewaylib.Process):
         self._parsed = {}
         super().__init__(*args, **kwargs)
 
+    def report(self):
+        """The messages decoded, one a line (the raw log is hex)."""
+        return self.dump()
+
     def _message(self, index, line):
         found = self._parsed.get(index)
         if found is None:
