@@ -590,6 +590,15 @@ class CellTestCase(unittest.TestCase):
 _TRACE_LINE = re.compile(r"(\S+): (request|reply \S+) ([0-9A-F]{2}(?: [0-9A-F]{2})*)$")
 
 
+def rss_kib(pid):
+    """The resident set of process @p pid in KiB (a bound on what a client may cost)."""
+    with open("/proc/%d/status" % pid, encoding="ascii") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    raise AssertionError("no VmRSS for %d" % pid)
+
+
 def _read(path):
     try:
         with open(path, "rb") as f:

@@ -16,6 +16,8 @@ its tearDown."""
 
 import json
 import pathlib
+import socket
+import struct
 import sys
 import time
 
@@ -282,6 +284,40 @@ def command_payload(metrics, seq=None):
         payload["seq"] = seq
     payload["metrics"] = [dict(metric) for metric in metrics]
     return decoder().encode(payload)
+
+
+def _mqtt_packet(kind, body):
+    """An MQTT 3.1.1 control packet: fixed header (remaining length varint) and body."""
+    length, encoded = len(body), bytearray()
+    while True:
+        byte, length = length % 128, length // 128
+        encoded.append(byte | (0x80 if length else 0))
+        if not length:
+            return bytes([kind]) + bytes(encoded) + body
+
+
+def _mqtt_string(data):
+    return struct.pack(">H", len(data)) + data
+
+
+def flood(port, client_id, messages, timeout=30.0):
+    """Publishes @p messages ((topic, payload bytes) pairs) at QoS 0 as fast as one TCP
+    connection to the broker on 127.0.0.1:@p port takes them (MQTT 3.1.1 written here:
+    mosquitto_pub starts a process per message), then disconnects. A host that floods
+    the node with commands."""
+    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as sock:
+        connect = _mqtt_string(b"MQTT") + bytes([4, 0x02]) + struct.pack(">H", 30) + _mqtt_string(client_id.encode())
+        sock.sendall(_mqtt_packet(0x10, connect))
+        connack = sock.recv(4)
+        if connack[:1] != b"\x20" or connack[3:4] != b"\x00":
+            raise AssertionError("the broker refused the flooding client: %r" % connack)
+        batch = bytearray()
+        for topic, payload in messages:
+            batch += _mqtt_packet(0x30, _mqtt_string(topic.encode()) + payload)
+            if len(batch) >= 65536:
+                sock.sendall(batch)
+                batch.clear()
+        sock.sendall(bytes(batch) + _mqtt_packet(0xE0, b""))
 
 
 def state_payload(online, timestamp=None):

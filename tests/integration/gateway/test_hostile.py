@@ -131,7 +131,7 @@ class MqttBounds(gatewaylib.CellTestCase):
                                     lambda r: r["id"] == "warm-up")
         self.assertTrue(first["ok"], first)
         log_before = os.path.getsize(self.gateway.log_path)
-        rss_before = rss_kib(self.gateway.pid)
+        rss_before = gatewaylib.rss_kib(self.gateway.pid)
         # 20 commands of ~900 KB each.
         big = self.path("big-command.json")
         with open(big, "w", encoding="ascii") as f:
@@ -155,7 +155,7 @@ class MqttBounds(gatewaylib.CellTestCase):
         self.assertTrue(all(r["id"] is None for r in too_large))
         # Neither the results nor the log carry the payloads; memory did not follow them.
         self.assertLess(os.path.getsize(self.gateway.log_path) - log_before, 200000)
-        self.assertLess(rss_kib(self.gateway.pid) - rss_before, 64 * 1024)
+        self.assertLess(gatewaylib.rss_kib(self.gateway.pid) - rss_before, 64 * 1024)
 
 
     def huge_command(self, megabytes):
@@ -179,7 +179,7 @@ class MqttBounds(gatewaylib.CellTestCase):
         warm = self.command_result("gripper-1", json.dumps({"id": "warm-up", "op": "stop"}),
                                    lambda r: r["id"] == "warm-up")
         self.assertTrue(warm["ok"], warm)
-        rss_before = rss_kib(self.gateway.pid)
+        rss_before = gatewaylib.rss_kib(self.gateway.pid)
         mark = self.sub.mark()
         self.publish_file(self.huge_command(64))
         # A command after it is answered (results come in order): by then the huge one
@@ -189,7 +189,7 @@ class MqttBounds(gatewaylib.CellTestCase):
         self.assertTrue(after["ok"], after)
         self.assertEqual([p for _, p in self.sub.messages(PREFIX + "/gripper-1/cmd/result", mark)
                           if "too_large" in p], [], "the 64 MB command reached the gateway")
-        self.assertLess(rss_kib(self.gateway.pid) - rss_before, 16 * 1024)
+        self.assertLess(gatewaylib.rss_kib(self.gateway.pid) - rss_before, 16 * 1024)
 
     def test_mqtt5_a_huge_publish_is_never_sent_to_the_gateway(self):
         # Issue 24 item 3: one 64 MB publish took the gateway's RSS from 90 to 247 MB
@@ -457,14 +457,6 @@ class MetricsHttp(gatewaylib.CellTestCase):
         self.assertGreater(scrapes, 0)
         self.assertTrue(self.gateway.running())
         self.assertIn("fieldbridge_build_info", self.scrape())
-
-
-def rss_kib(pid):
-    with open("/proc/%d/status" % pid, encoding="ascii") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1])
-    raise AssertionError("no VmRSS for %d" % pid)
 
 
 if __name__ == "__main__":

@@ -11,12 +11,18 @@ left out by its class name on the command line):
   CommandsAccepted, CommandsRefused   DCMD writes (WTEC metrics, XEG Commands/move)
   Deaths          clean stop NDEATH, SIGKILL will, bdSeq kept in state_dir
   DeviceOffline   dead device / unplugged line -> DDEATH, back -> DBIRTH
-  PrimaryHost     births wait for STATE online; offline walks to the next server
-  OfflineBuffer   data made while the host is offline replayed as historical"""
+  PrimaryHost     births wait for STATE online; offline walks to the next server; a
+                  malformed STATE is ignored, logged escaped
+  OfflineBuffer   data made while the host is offline replayed as historical
+  Reload          SIGHUP: a device removed, added or redefined is born again alone; a
+                  line removed re-births the node
+  CommandFlood    9000 DCMDs at once: bounded memory, Modbus TCP keeps answering"""
 
 import os
 import signal
 import subprocess
+import threading
+import time
 
 import gatewaylib
 import simlib
@@ -87,10 +93,12 @@ class SparkplugCell(gatewaylib.CellTestCase):
 
     # -- starting --------------------------------------------------------------------
 
-    def start(self, primary=False, second_broker=False, r6=False, seed_bdseq=None, before_gateway=None):
+    def start(self, primary=False, second_broker=False, r6=False, seed_bdseq=None, before_gateway=None,
+              extra_config="", **cell):
         """The cell with the JSON bridge and the Sparkplug node; self.spb (and self.spb_b
         on the second broker) subscribed to spBv1.0/# and self.json to the JSON states
-        before the gateway starts."""
+        before the gateway starts. extra_config: more top-level configuration (e.g.
+        `definitions:`); cell: more of start_cell()'s arguments (extra_lines, sim_extra)."""
         if seed_bdseq is not None:
             with open(os.path.join(self.state_dir, "sparkplug-bdseq"), "w", encoding="utf-8") as f:
                 f.write("%d\n" % seed_bdseq)
@@ -98,7 +106,8 @@ class SparkplugCell(gatewaylib.CellTestCase):
         if second_broker:
             self.port_b = gatewaylib.free_port()
             servers.append(str(self.port_b))
-        self.mqtt_config = gatewaylib.MQTT_CONFIG + sparkplug_section(self.state_dir, servers, primary)
+        self.mqtt_config = (gatewaylib.MQTT_CONFIG + sparkplug_section(self.state_dir, servers, primary)
+                            + extra_config.replace("{", "{{").replace("}", "}}"))
 
         def first():
             self.spb = self.spb_subscribe(self.broker, self.mqtt_port, "spBv1.0/#")
@@ -108,7 +117,7 @@ class SparkplugCell(gatewaylib.CellTestCase):
                 self.spb_b = self.spb_subscribe(self.broker_b, self.port_b, "spBv1.0/#")
             if before_gateway is not None:
                 before_gateway()
-        self.start_cell(mqtt=True, r6=r6, before_gateway=first)
+        self.start_cell(mqtt=True, r6=r6, before_gateway=first, **cell)
 
     def start_broker_b(self):
         conf = self.path("mosquitto-b.conf")
@@ -684,6 +693,33 @@ class PrimaryHost(SparkplugCell):
         self.assert_seq()
         self.assert_seq(self.spb_b)
 
+    def test_a_malformed_state_is_ignored_logged_escaped_and_the_session_goes_on(self):
+        self.start(primary=True, before_gateway=lambda: self.host_state(True, sparkplug_host.now_ms()))
+        nbirth, _ = self.wait_births()
+        mark, log_mark = self.spb.mark(), len(self.gateway.text().splitlines())
+        forged = "2026-01-01 00:00:00.000 [critical] forged"
+        bad = [b"not json\n" + forged.encode(),                   # a forged log line inside
+               b'{"online": false}',                               # no timestamp
+               b'{"online": "no", "timestamp": 1}',                # not a Boolean
+               b"\xff\xfe\x00" + b"x" * 100000]                    # binary, 100 kB
+        for payload in bad:
+            self.publish_bytes(STATE_TOPIC, payload, retain=True)
+        found = simlib.wait_until(
+            lambda: sum("STATE of primary host" in line and "is ignored" in line
+                        for line in self.gateway.text().splitlines()[log_mark:]) >= len(bad), TIMEOUT, interval=0.1)
+        self.assertTrue(found, "not every malformed STATE was logged:\n" + self.gateway.text())
+        logged = self.gateway.text().splitlines()[log_mark:]
+        self.assertFalse([line for line in logged if line.startswith(forged)], "a forged log line got through")
+        self.assertLess(max(len(line) for line in logged), 1000, "a STATE was logged whole")
+        # The session goes on: no death, and the host's next STATE still counts.
+        self.quiet(1.0)
+        self.assertEqual([m for m in self.spb.messages(mark) if m.kind in ("NDEATH", "NBIRTH")], [])
+        self.assertTrue(self.gateway.running())
+        self.host_state(False, sparkplug_host.now_ms())
+        ndeath = self.spb.wait_kind("NDEATH", TIMEOUT, mark)
+        self.assertIsNotNone(ndeath, "no NDEATH for the well-formed STATE offline:\n" + self.spb.dump(mark))
+        self.assert_ndeath(ndeath, self.bdseq_of(nbirth))
+
 
 class OfflineBuffer(SparkplugCell):
 
@@ -749,6 +785,160 @@ class OfflineBuffer(SparkplugCell):
         self.assertEqual(positions, sorted(positions))
         self.assertEqual(positions[-1], 32.0)
         self.assertLess(positions[0], 32.0)
+        self.assert_seq()
+
+
+METER_DEFINITION = """\
+name: spb-meter
+description: a meter written by the Sparkplug reload test
+period: 200ms
+points:
+  - {{name: voltage, table: input, address: 0x0000, type: float32, unit: {unit}}}
+  - {{name: status, table: input, address: 0x0004}}
+"""
+
+METER_LINE = """\
+  - name: line-c
+    port: {port}
+    baud: 115200
+    response_timeout: 300ms
+    devices:
+      - {{name: meter-1, type: spb-meter, address: 9, unit_id: 21, command_ttl: 2s}}
+"""
+
+STEPPER_LINE = "      - {name: stepper-1, type: excd203mb, address: 3, unit_id: 2, command_ttl: 2s}\n"
+
+
+class Reload(SparkplugCell):
+    """SIGHUP re-births only what changed (docs/sparkplug-session.md, "Reload")."""
+
+    def write_meter_definition(self, unit):
+        with open(os.path.join(self.definitions, "spb-meter.yaml"), "w", encoding="utf-8") as f:
+            f.write(METER_DEFINITION.format(unit=unit))
+
+    def reload(self):
+        mark = len(self.gateway.text().splitlines())
+        self.gateway.signal(signal.SIGHUP)
+        if self.gateway.wait_line(lambda line: "configuration reloaded" in line, TIMEOUT, start=mark) is None:
+            self.fail("reload not applied:\n%s" % self.gateway.text())
+
+    def assert_only(self, mark, expected):
+        """From @p mark on, the births and deaths are exactly @p expected ((kind, device)
+        pairs, in order)."""
+        self.quiet(1.0)
+        seen = [(m.kind, m.device) for m in self.spb.messages(mark)
+                if m.kind in ("NBIRTH", "NDEATH", "DBIRTH", "DDEATH")]
+        self.assertEqual(seen, expected, self.spb.dump(mark))
+
+    def test_a_device_removed_added_or_changed_is_born_again_alone_and_a_line_removed_rebirths_the_node(self):
+        self.definitions = self.path("devices")
+        os.mkdir(self.definitions)
+        self.write_meter_definition("V")
+        line_c = METER_LINE.format(port=self.path("line-c"))
+        self.start(extra_config="definitions: [%s]\n" % self.definitions, extra_lines=line_c,
+                   sim_extra=("--definitions", self.definitions, "--bus", self.path("line-c") + ":spb-meter@9"))
+        nbirth, births = self.wait_births(devices=DEVICES + ("meter-1",))
+        bdseq = self.bdseq_of(nbirth)
+        self.assertEqual(births["meter-1"].metric("voltage")["properties"]["engUnit"], STRING_UNIT("V"))
+
+        # A device removed: its DDEATH, nothing else.
+        mark = self.spb.mark()
+        self.rewrite_config(STEPPER_LINE, "")
+        self.reload()
+        self.assertIsNotNone(self.spb.wait_kind("DDEATH", TIMEOUT, mark, device="stepper-1"),
+                             "no DDEATH of the removed stepper-1:\n" + self.spb.dump(mark))
+        self.assert_only(mark, [("DDEATH", "stepper-1")])
+
+        # A device added (the same drive under a new name): its DBIRTH, nothing else.
+        mark = self.spb.mark()
+        self.rewrite_config("      - {name: gripper-2,", STEPPER_LINE.replace("stepper-1", "stepper-2")
+                            + "      - {name: gripper-2,")
+        self.reload()
+        added = self.spb.wait_kind("DBIRTH", TIMEOUT, mark, device="stepper-2")
+        self.assertIsNotNone(added, "no DBIRTH of the added stepper-2:\n" + self.spb.dump(mark))
+        self.assertEqual(field_names(added), field_names(births["stepper-1"]))
+        self.assert_only(mark, [("DBIRTH", "stepper-2")])
+
+        # A device whose metric definitions changed (the unit of a point): DDEATH, then
+        # DBIRTH with the new definition and the same aliases.
+        mark = self.spb.mark()
+        self.write_meter_definition("kV")
+        self.reload()
+        again = self.spb.wait(lambda m: m.kind == "DBIRTH" and m.device == "meter-1", TIMEOUT, mark)
+        self.assertIsNotNone(again, "no DBIRTH of meter-1 with its new unit:\n" + self.spb.dump(mark))
+        self.assertEqual(again.metric("voltage")["properties"]["engUnit"], STRING_UNIT("kV"))
+        self.assertEqual(again.metric("voltage")["alias"], births["meter-1"].metric("voltage")["alias"])
+        self.assert_only(mark, [("DDEATH", "meter-1"), ("DBIRTH", "meter-1")])
+
+        # A line removed changes the node's own metrics (Lines/line-c/...): meter-1's
+        # DDEATH, then the whole node is born again, same bdSeq, no NDEATH, without it.
+        mark = self.spb.mark()
+        self.rewrite_config(line_c, "")
+        self.reload()
+        rebirth, rebirths = self.wait_births(start=mark, devices=("gripper-1", "stepper-2", "gripper-2", "gripper-3"))
+        self.assertEqual((rebirth.seq, self.bdseq_of(rebirth)), (0, bdseq))
+        self.assertFalse([m for m in rebirth.metrics if m["name"].startswith("Lines/line-c/")], rebirth)
+        self.assertTrue([m for m in rebirth.metrics if m["name"].startswith("Lines/line-a/")], rebirth)
+        reborn = sorted(rebirths, key=lambda device: rebirths[device].index)
+        self.assert_only(mark, [("DDEATH", "meter-1"), ("NBIRTH", None)] + [("DBIRTH", d) for d in reborn])
+        self.assertEqual([m.kind for m in self.spb.messages(mark, device="meter-1")], ["DDEATH"])
+        self.assertEqual(self.spb.messages(kind="NDEATH"), [])
+        self.assert_seq()
+
+
+class CommandFlood(SparkplugCell):
+    """A host that floods DCMDs (good, refused and undecodable) costs the gateway bounded
+    memory, the Modbus TCP side keeps answering, and a command after the flood works."""
+
+    def test_a_dcmd_flood_is_bounded_and_the_gateway_stays_responsive(self):
+        self.start()
+        self.wait_births()
+        self.wait_json("gripper-3", lambda s: set(s["fields"]) == WTEC_RTU_FIELDS)
+        client = self.client()
+        rss_before = gatewaylib.rss_kib(self.gateway.pid)
+        topic = spb_topic("DCMD", "gripper-3")
+        messages = []
+        for number in range(3000):
+            messages.append((topic, command_payload([{"name": "force_pct", "datatype": "Int64",
+                                                      "value": 20 + number % 80}])))
+            messages.append((topic, b"\x0a\xff\xff\x01"))  # undecodable
+            messages.append((spb_topic("DCMD", "no-such-device"), messages[-2][1]))
+        failures = []
+
+        def flood():
+            try:
+                sparkplug_host.flood(self.mqtt_port, "fb-spb-flood", messages)
+            except (OSError, AssertionError) as e:
+                failures.append(e)
+        flooder = threading.Thread(target=flood, daemon=True)
+        started = time.monotonic()
+        flooder.start()
+        reads, slowest = 0, 0.0
+        while flooder.is_alive() or reads < 20:
+            asked = time.monotonic()
+            self.read_input(client, 0x0300, 2, 1)
+            slowest = max(slowest, time.monotonic() - asked)
+            reads += 1
+            self.assertLess(time.monotonic() - started, 120, "the flood did not end in 120 s")
+        flooder.join(5)
+        self.assertEqual(failures, [])
+        # Refused, dropped (over the 64 waiting) or executed: counted, never queued
+        # without bound.
+        refused = self.wait_node_metric("Properties/Commands Refused", lambda n: n >= 1000, 0, 2 * NDATA_PERIOD + 10)
+        grown = gatewaylib.rss_kib(self.gateway.pid) - rss_before
+        print("flood of %d DCMDs: %d Modbus TCP reads meanwhile, the slowest %.3f s; %d refused or dropped, "
+              "%d executed, %d KiB more resident" % (len(messages), reads, slowest, refused,
+                                                     NodeView.of(self.spb.messages()).node["Properties/Commands Accepted"],
+                                                     grown))
+        self.assertLess(grown, 64 * 1024, "the flood cost %d KiB" % grown)
+        # A command sent once the flood is over is executed (again while the last of
+        # the flood still runs: at most 16 DCMDs at once).
+        def force_is_42():
+            self.dcmd("gripper-3", [{"name": "force_pct", "datatype": "Int64", "value": 42}])
+            return simlib.wait_until(lambda: self.read_holding(client, 0x0103, 1, 4) == [42], 5.0, interval=0.1)
+        self.assertTrue(simlib.wait_until(force_is_42, 4 * TIMEOUT, interval=0.1),
+                        "force_pct = 42 never reached the WTEC after the flood")
+        self.assertTrue(self.gateway.running())
         self.assert_seq()
 
 
