@@ -27,7 +27,7 @@ MqttComponent::~MqttComponent() {
     if (bridge_) bridge_->leave_client_to_process_exit();
     bridge_.reset();
     // The engine may already be gone (stopped after us): never touch the agents.
-    detach_sources();
+    sources_.detach();
 }
 
 void MqttComponent::start(daemon::StartContext& context) {
@@ -71,31 +71,16 @@ void MqttComponent::build() {
 }
 
 void MqttComponent::refresh_sources() {
-    detach_sources();
-    if (!bridge_) return;
-    engine::Engine* e = engine_ ? engine_() : nullptr;
-    std::vector<std::shared_ptr<mqtt::DeviceSource>> sources;
-    if (e != nullptr) {
-        for (const engine::DeviceEntry& entry : e->devices()) {
-            auto source = std::make_shared<mqtt::AgentSource>(io_, *entry.agent, entry.mqtt_commands);
-            sources_.push_back(source);
-            sources.push_back(std::move(source));
-        }
+    if (!bridge_) {
+        sources_.detach();
+        return;
     }
-    for (const auto& provider : source_providers_) {
-        for (auto& source : provider()) sources.push_back(std::move(source));
-    }
-    bridge_->set_sources(std::move(sources));
-}
-
-void MqttComponent::detach_sources() {
-    for (auto& source : sources_) source->detach();
-    sources_.clear();
+    bridge_->set_sources(sources_.rebuild(engine_ ? engine_() : nullptr));
 }
 
 void MqttComponent::stop(daemon::StopContext& context) {
     if (!bridge_) {
-        detach_sources();
+        sources_.detach();
         return;
     }
     auto ticket = std::make_shared<daemon::CompletionBarrier::Ticket>(
@@ -103,7 +88,7 @@ void MqttComponent::stop(daemon::StopContext& context) {
     bridge_->stop([ticket] { ticket->done(); });
     // The engine stops after this component: the sources must not outlive it.
     bridge_->set_sources({});
-    detach_sources();
+    sources_.detach();
 }
 
 void MqttComponent::retire(std::unique_ptr<mqtt::Bridge> bridge) {
@@ -123,7 +108,7 @@ void MqttComponent::apply(std::shared_ptr<const config::Config> config) {
         // already: forget the old ones now, take the new ones once every component
         // has applied the configuration.
         if (bridge_) bridge_->set_sources({});
-        detach_sources();
+        sources_.detach();
         refresh_pending_ = true;
     }
     if (mqtt_changed) {
@@ -143,8 +128,8 @@ void MqttComponent::apply(std::shared_ptr<const config::Config> config) {
 
 void MqttComponent::add_diag(mqtt::DiagProvider provider) { diag_.push_back(std::move(provider)); }
 
-void MqttComponent::add_sources(SourceProvider provider) {
-    source_providers_.push_back(std::move(provider));
+void MqttComponent::add_sources(DeviceSources::Provider provider) {
+    sources_.add_provider(std::move(provider));
     if (bridge_ && !refresh_pending_) refresh_sources();
 }
 

@@ -18,6 +18,7 @@
 
 #include <asio/io_context.hpp>
 
+#include "app/device_sources.hpp"
 #include "app/engine_diag.hpp"
 #include "daemon/component.hpp"
 #include "engine/engine.hpp"
@@ -52,8 +53,7 @@ public:
     /// More devices (the R6 units of the upstream pass-through: make_r6_sources()),
     /// asked at start and whenever the sources are rebuilt. Their owner detaches them
     /// before the objects behind them go.
-    using SourceProvider = std::function<std::vector<std::shared_ptr<mqtt::DeviceSource>>()>;
-    void add_sources(SourceProvider provider);
+    void add_sources(DeviceSources::Provider provider);
     /// Nullptr when MQTT is off.
     [[nodiscard]] const mqtt::Bridge* bridge() const noexcept { return bridge_.get(); }
     /// For STATUS=: "MQTT connected" / "MQTT connecting" / "MQTT off".
@@ -62,7 +62,6 @@ public:
 private:
     void build();
     void refresh_sources();
-    void detach_sources();
     void retire(std::unique_ptr<mqtt::Bridge> bridge);
 
     asio::io_context& io_;
@@ -71,9 +70,8 @@ private:
     ClientFactory clients_;
     std::shared_ptr<const config::Config> config_;
     std::unique_ptr<mqtt::Bridge> bridge_;
-    std::vector<std::shared_ptr<mqtt::AgentSource>> sources_;
+    DeviceSources sources_{io_, /*notices=*/true};
     std::vector<mqtt::DiagProvider> diag_;
-    std::vector<SourceProvider> source_providers_;
     EngineDiag engine_diag_;
     bool refresh_pending_ = false;  ///< the engine is being rebuilt: its agents come later
     /// Set to false when the component goes: posted refreshes do nothing then.

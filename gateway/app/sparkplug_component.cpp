@@ -44,7 +44,7 @@ SparkplugComponent::~SparkplugComponent() {
     *alive_ = false;
     if (node_) node_->leave_client_to_process_exit();
     node_.reset();
-    detach_sources();
+    sources_.detach();
 }
 
 void SparkplugComponent::start(daemon::StartContext& context) {
@@ -109,41 +109,27 @@ sparkplug_node::NodeSnapshot SparkplugComponent::snapshot() {
 }
 
 void SparkplugComponent::refresh_sources() {
-    detach_sources();
-    if (!node_) return;
-    std::vector<std::shared_ptr<mqtt::DeviceSource>> sources;
-    if (engine::Engine* e = engine_ ? engine_() : nullptr) {
-        for (const engine::DeviceEntry& entry : e->devices()) {
-            auto source = std::make_shared<mqtt::AgentSource>(io_, *entry.agent, entry.mqtt_commands, /*notices=*/false);
-            sources_.push_back(source);
-            sources.push_back(std::move(source));
-        }
+    if (!node_) {
+        sources_.detach();
+        return;
     }
-    for (const auto& provider : source_providers_) {
-        for (auto& source : provider()) sources.push_back(std::move(source));
-    }
-    node_->set_sources(std::move(sources));
+    node_->set_sources(sources_.rebuild(engine_ ? engine_() : nullptr));
 }
 
-void SparkplugComponent::add_sources(SourceProvider provider) {
-    source_providers_.push_back(std::move(provider));
+void SparkplugComponent::add_sources(DeviceSources::Provider provider) {
+    sources_.add_provider(std::move(provider));
     if (node_ && !refresh_pending_) refresh_sources();
-}
-
-void SparkplugComponent::detach_sources() {
-    for (auto& source : sources_) source->detach();
-    sources_.clear();
 }
 
 void SparkplugComponent::stop(daemon::StopContext& context) {
     if (!node_) {
-        detach_sources();
+        sources_.detach();
         return;
     }
     auto ticket = std::make_shared<daemon::CompletionBarrier::Ticket>(context.expect_finished("Sparkplug NDEATH"));
     node_->stop([ticket] { ticket->done(); });
     // The engine stops after this component: the sources must not outlive it.
-    detach_sources();
+    sources_.detach();
 }
 
 void SparkplugComponent::retire(std::unique_ptr<sparkplug_node::EdgeNode> node) {
@@ -164,7 +150,7 @@ void SparkplugComponent::apply(std::shared_ptr<const config::Config> config) {
     if (engine_rebuilt) {
         // The engine component rebuilds its agents on this same reload: forget the old
         // ones now, take the new ones once every component has applied the configuration.
-        detach_sources();
+        sources_.detach();
         refresh_pending_ = true;
     }
     if (node_changed) {

@@ -19,6 +19,7 @@
 
 #include <asio/io_context.hpp>
 
+#include "app/device_sources.hpp"
 #include "daemon/component.hpp"
 #include "engine/engine.hpp"
 #include "northbound/mqtt/agent_source.hpp"
@@ -50,8 +51,7 @@ public:
     /// More devices (the R6 units of the upstream pass-through, sources of their own:
     /// make_r6_sources() with a copy for this node), asked at start and whenever the
     /// sources are rebuilt. Their owner detaches them before the objects behind them go.
-    using SourceProvider = std::function<std::vector<std::shared_ptr<northbound::mqtt::DeviceSource>>()>;
-    void add_sources(SourceProvider provider);
+    void add_sources(DeviceSources::Provider provider);
     /// Nullptr when Sparkplug is off.
     [[nodiscard]] const sparkplug_node::EdgeNode* node() const noexcept { return node_.get(); }
     /// For STATUS=: "Sparkplug online" / "Sparkplug connecting"; empty when off.
@@ -60,7 +60,6 @@ public:
 private:
     void build();
     void refresh_sources();
-    void detach_sources();
     void retire(std::unique_ptr<sparkplug_node::EdgeNode> node);
     [[nodiscard]] sparkplug_node::NodeSnapshot snapshot();
 
@@ -77,8 +76,7 @@ private:
     ProbeExtras extras_;
     std::shared_ptr<const config::Config> config_;
     std::unique_ptr<sparkplug_node::EdgeNode> node_;
-    std::vector<std::shared_ptr<northbound::mqtt::AgentSource>> sources_;
-    std::vector<SourceProvider> source_providers_;
+    DeviceSources sources_{io_, /*notices=*/false};
     std::map<std::string, LineSample, std::less<>> samples_;
     bool refresh_pending_ = false;
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
