@@ -51,6 +51,7 @@ done
 packages=(
   # toolchain
   build-essential cmake ninja-build g++ pkg-config
+  ccache  # every build on this machine and in the build roots (deploy/compiler-cache.sh)
   clang libclang-rt-14-dev  # the fuzz build (tests/fuzz): clang++ and its libFuzzer
   protobuf-c-compiler  # protoc-c: the Sparkplug B schema's C code, generated at build time
   "${libraries[@]}"
@@ -67,9 +68,10 @@ root_packages=()
 if [ "$dist" != bookworm ]; then
   # The build root's packages: the list above from that release, without the fuzz
   # build's clang (the campaign runs on Debian 12 only), with ccache (the root's builds
-  # use the cache of deploy/dist/in-root) and strace (docs/performance.md).
+  # use the cache of deploy/dist/in-root) and strace (docs/performance.md) last: the
+  # list is the root's stamp, and its order unchanged keeps existing roots.
   for p in "${packages[@]}"; do
-    case "$p" in clang|libclang-rt-*) ;; *) root_packages+=("$p") ;; esac
+    case "$p" in clang|libclang-rt-*|ccache) ;; *) root_packages+=("$p") ;; esac
   done
   root_packages+=(ccache strace)
   packages=(mmdebstrap)
