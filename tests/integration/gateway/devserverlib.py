@@ -7,6 +7,8 @@ For the tests of issue 27 it can misbehave on purpose, one reply at a time:
   split   every reply leaves in two TCP segments, `split_gap` apart
   merge   the next reply is held and leaves in one segment with the reply after it
   late    the next reply is held and leaves just after the client's next request
+(a reply may come off the pseudo-terminal in several reads, the simulator pacing it at
+the wire's rate: everything the line sends is held until the client's next request)
   cut     the next reply: its first half, then the connection is closed
 and refuse() / listen() close and reopen the listening socket (connections refused
 meanwhile). Python 3 standard library only; one thread; every wait bounded."""
@@ -31,6 +33,7 @@ class DeviceServer:
         self.mode = None          # None, "split", "merge", "late", "cut"
         self.split_gap = 0.002
         self.held = b""
+        self.asked_again = False  # merge: the client sent its next request since the hold
         self.accepted = 0         # connections taken
         self.turned_away = 0      # second clients closed at once
         self.accepted_at = []     # time.monotonic() of each accept
@@ -65,6 +68,7 @@ class DeviceServer:
         with self._lock:
             self.mode = mode
             self.held = b""
+            self.asked_again = False
 
     def close(self):
         self._stop = True
@@ -135,6 +139,8 @@ class DeviceServer:
             self.client.sendall(self.held)
             self.held = b""
             self.mode = None
+        elif self.mode == "merge" and self.held:
+            self.asked_again = True  # the held reply goes out with the first of the next
         os.write(self.pty, data)
 
     def _from_line(self):
@@ -150,12 +156,13 @@ class DeviceServer:
             self.client.sendall(data[:half])
             time.sleep(self.split_gap)
             self.client.sendall(data[half:])
-        elif mode in ("merge", "late") and not self.held:
-            self.held = data
-        elif mode == "merge":
+        elif mode == "merge" and self.asked_again:
             self.client.sendall(self.held + data)
             self.held = b""
+            self.asked_again = False
             self.mode = None
+        elif mode in ("merge", "late"):
+            self.held += data
         elif mode == "cut":
             self.client.sendall(data[:max(1, len(data) // 2)])
             self._drop_client()
