@@ -127,6 +127,9 @@ struct OpenFailed {
 struct BytesRead {
     protocol::ByteView bytes;
     bool buffer_full = false;
+    /// When the bytes reached this machine, when the port knows it
+    /// (SerialPort::last_arrival()); nullopt: the event's time stands in.
+    std::optional<TimePoint> arrived = std::nullopt;
 };
 /// Answer to next == write: the driver took every byte.
 struct Written {};
