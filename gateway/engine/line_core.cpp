@@ -308,7 +308,7 @@ void LineCore::on(TimePoint now, line_event::TimerFired& event, LineStep& step) 
 
 void LineCore::on(TimePoint now, line_event::BytesRead& event, LineStep& step) {
     if (!answered(LineNext::read, LineNext::read, "BytesRead")) return;
-    if (!event.bytes.empty()) master_.on_bytes(event.bytes, now, event.arrived);
+    if (!event.bytes.empty()) master_.on_bytes(event.bytes, now);
     if (event.buffer_full) {
         // Read until the buffer is not full: what is left would only be seen on the
         // next readiness report, after a decision it may change.

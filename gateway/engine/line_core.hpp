@@ -127,9 +127,6 @@ struct OpenFailed {
 struct BytesRead {
     protocol::ByteView bytes;
     bool buffer_full = false;
-    /// When the bytes reached this machine, when the port knows it
-    /// (SerialPort::last_arrival()); nullopt: the event's time stands in.
-    std::optional<TimePoint> arrived = std::nullopt;
 };
 /// Answer to next == write: the driver took every byte.
 struct Written {};

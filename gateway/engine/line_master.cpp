@@ -260,7 +260,7 @@ protocol::ByteView LineMaster::take_echo(protocol::ByteView bytes) {
     return bytes.subspan(taken);
 }
 
-void LineMaster::on_bytes(protocol::ByteView bytes, TimePoint now, std::optional<TimePoint> arrived) {
+void LineMaster::on_bytes(protocol::ByteView bytes, TimePoint now) {
     if (bytes.empty()) return;
     counters_.bytes_rx += bytes.size();
     // RTU frames are separated by at least t3.5 of silence (Modbus over Serial Line
@@ -280,7 +280,7 @@ void LineMaster::on_bytes(protocol::ByteView bytes, TimePoint now, std::optional
         case MasterState::sending:
         case MasterState::discarding_echo:
         case MasterState::awaiting_reply: {
-            if (late_on_stream(std::min(now, arrived.value_or(now)))) {
+            if (late_on_stream(now)) {
                 counters_.garbage_bytes += bytes.size();
                 if (log_.enabled(LogLevel::debug)) {
                     log_(LogLevel::debug, describe() + ": dropped " + std::to_string(bytes.size()) +

@@ -114,10 +114,7 @@ public:
     void on_written(TimePoint now);
 
     /// Bytes read from the port at @p now (any state: idle bytes are garbage).
-    /// @p arrived: when the bytes reached this machine, if the port knows (a TCP line:
-    /// the kernel's timestamp); the late-reply rule of a stream line uses it, so a loop
-    /// that reads late does not take a late reply for an answer.
-    void on_bytes(protocol::ByteView bytes, TimePoint now, std::optional<TimePoint> arrived = std::nullopt);
+    void on_bytes(protocol::ByteView bytes, TimePoint now);
 
     /// The port failed: hands back the transaction in flight, if any. Not yet written:
     /// `line_down`; written (the device may have acted): `timeout`, or `broadcast_sent`

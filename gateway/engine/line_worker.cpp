@@ -216,7 +216,7 @@ private:
     LineEvent read() {
         try {
             const protocol::ByteView bytes = port_.read_some();
-            return line_event::BytesRead{bytes, port_.buffer_filled(), port_.last_arrival()};
+            return line_event::BytesRead{bytes, port_.buffer_filled()};
         } catch (const SerialPortError& error) {
             return line_event::PortFailed{"read", error.what()};
         }

@@ -13,7 +13,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <utility>
 
@@ -51,10 +50,6 @@ public:
     [[nodiscard]] protocol::ByteView read_some();
     /// True when the last read filled the buffer (more may be waiting).
     [[nodiscard]] bool buffer_filled() const noexcept { return last_read_ == buffer_.size(); }
-    /// When the last read's bytes arrived, if the port knows (SerialPort::last_arrival()).
-    [[nodiscard]] std::optional<std::chrono::steady_clock::time_point> last_arrival() const noexcept {
-        return last_read_ > 0 ? port_->last_arrival() : std::nullopt;
-    }
 
     /// Calls @p handler(asio::error_code) once the fd is readable (or hung up).
     template <typename Handler>

@@ -87,12 +87,6 @@ public:
     virtual void finish_open() {}
     /// How long an open that only began may take before the caller gives up.
     [[nodiscard]] virtual std::chrono::milliseconds open_timeout() const noexcept { return {}; }
-    /// When the bytes of the last read_some() reached this machine (steady clock), when
-    /// the port knows it (a TCP stream: the kernel's receive timestamp); nullopt
-    /// otherwise, and then the reader's own clock stands in.
-    [[nodiscard]] virtual std::optional<std::chrono::steady_clock::time_point> last_arrival() const noexcept {
-        return std::nullopt;
-    }
 };
 
 }  // namespace fieldbridge::engine

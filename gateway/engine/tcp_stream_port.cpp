@@ -6,14 +6,10 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
-#include <sys/time.h>
-#include <sys/uio.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstring>
-#include <optional>
 #include <utility>
 
 #include "core/error.hpp"
@@ -29,24 +25,6 @@ constexpr int keepalive_idle_s = 5;
 constexpr int keepalive_interval_s = 2;
 constexpr int keepalive_count = 3;
 constexpr unsigned user_timeout_ms = 10000;
-
-/// The SO_TIMESTAMP of a received message (the time its last segment arrived, on the
-/// system clock) on the steady clock: now, less how long ago it came by the system
-/// clock. Nullopt without one, or when the system clock jumped (more than 10 s, or
-/// into the future).
-[[nodiscard]] std::optional<std::chrono::steady_clock::time_point> arrival_of(msghdr& message) {
-    for (cmsghdr* c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c)) {
-        if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMP) continue;
-        timeval stamp{};
-        std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
-        const auto steady_now = std::chrono::steady_clock::now();
-        const auto ago = std::chrono::system_clock::now().time_since_epoch() -
-                         (std::chrono::seconds{stamp.tv_sec} + std::chrono::microseconds{stamp.tv_usec});
-        if (ago < std::chrono::system_clock::duration::zero() || ago > std::chrono::seconds{10}) return std::nullopt;
-        return steady_now - std::chrono::duration_cast<std::chrono::steady_clock::duration>(ago);
-    }
-    return std::nullopt;
-}
 
 [[nodiscard]] std::string address_text(const sockaddr* address) {
     char host[INET6_ADDRSTRLEN] = {};
@@ -119,8 +97,6 @@ void TcpStreamPort::set_options() {
     if (::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on) == -1) {
         fail("cannot set TCP_NODELAY", errno, "report it");
     }
-    // Receive timestamps (last_arrival()); without them the reader's clock stands in.
-    static_cast<void>(::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMP, &on, sizeof on));
     const int idle = keepalive_idle_s;
     const int interval = keepalive_interval_s;
     const int count = keepalive_count;
@@ -190,18 +166,8 @@ std::size_t TcpStreamPort::write_some(protocol::ByteView bytes) {
 }
 
 std::size_t TcpStreamPort::read_some(std::span<std::uint8_t> buffer) {
-    iovec data{buffer.data(), buffer.size()};
-    alignas(cmsghdr) std::uint8_t control[CMSG_SPACE(sizeof(timeval))];
-    msghdr message{};
-    message.msg_iov = &data;
-    message.msg_iovlen = 1;
-    message.msg_control = control;
-    message.msg_controllen = sizeof control;
-    const ssize_t n = ::recvmsg(fd_, &message, MSG_DONTWAIT);
-    if (n > 0) {
-        last_arrival_ = arrival_of(message);
-        return static_cast<std::size_t>(n);
-    }
+    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT);
+    if (n > 0) return static_cast<std::size_t>(n);
     if (n == 0) {
         fail("the device server " + peer() + " closed the connection", 0,
              "it may have restarted, or given its only connection to another client; it is reopened");

@@ -15,10 +15,8 @@
 /// (ConnectWait::block). A host name is resolved at each open; a name that resolves
 /// to several addresses is tried one address per attempt, in turn.
 
-#include <chrono>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,13 +49,6 @@ public:
     [[nodiscard]] std::chrono::milliseconds open_timeout() const noexcept override {
         return settings_.tcp->connect_timeout;
     }
-    /// The kernel's receive timestamp (SO_TIMESTAMP) of the last read's bytes, moved to
-    /// the steady clock: a loop that reads late (a loaded box, an emulator) still sees
-    /// when a late reply really came (LineMaster drops bytes that came before the
-    /// request could have left the device server).
-    [[nodiscard]] std::optional<std::chrono::steady_clock::time_point> last_arrival() const noexcept override {
-        return last_arrival_;
-    }
 
 private:
     /// The addresses the host resolves to now. Throws SerialPortError.
@@ -73,7 +64,6 @@ private:
     std::string connected_to_;  ///< the address text of the current connection
     int fd_ = -1;
     bool opening_ = false;
-    std::optional<std::chrono::steady_clock::time_point> last_arrival_;
 };
 
 }  // namespace fieldbridge::engine

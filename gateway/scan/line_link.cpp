@@ -133,7 +133,7 @@ engine::LineEvent LineLink::read() {
     const std::size_t n = port_.read_some(buffer_);  // throws SerialPortError: the scan stops
     const protocol::ByteView bytes(buffer_.data(), n);
     if (sink_ != nullptr) sink_->insert(sink_->end(), bytes.begin(), bytes.end());
-    return line_event::BytesRead{bytes, n == buffer_.size(), n > 0 ? port_.last_arrival() : std::nullopt};
+    return line_event::BytesRead{bytes, n == buffer_.size()};
 }
 
 engine::LineEvent LineLink::write(protocol::ByteView bytes) {

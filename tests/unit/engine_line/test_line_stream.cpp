@@ -99,29 +99,6 @@ TEST_CASE("stream: bytes before the request can have crossed the far side's line
     CHECK(std::get<fp::ReadRegistersResponse>(reply).values == std::vector<std::uint16_t>{0x0A20});
 }
 
-TEST_CASE("stream: the rule reads the bytes' arrival, not when the loop got to them") {
-    StreamSent s;
-    const Bytes stale = read_reply(2, {0x0BAD}, fp::fc::read_holding_registers);
-    SUBCASE("a late reply that came early, read 5 ms later by a busy loop, is still dropped") {
-        s.master.on_bytes(stale, s.tx_end + 5ms, s.written + 100us);
-        CHECK(s.master.state() == fe::MasterState::awaiting_reply);
-        CHECK(s.master.counters().garbage_bytes == stale.size());
-        s.master.on_bytes(read_model_reply, s.tx_end + 6ms, s.tx_end + 2ms);
-        auto done = expect_finished(s.master, s.tx_end + 6ms);
-        REQUIRE(done.outcome.status == OutcomeStatus::ok);
-        CHECK(std::get<fp::ReadRegistersResponse>(std::get<fp::Response>(done.outcome.reply)).values ==
-              std::vector<std::uint16_t>{0x0A20});
-    }
-    SUBCASE("without an arrival time the loop's time stands in: the same bytes are framed") {
-        s.master.on_bytes(stale, s.tx_end + 5ms);
-        CHECK(expect_finished(s.master, s.tx_end + 5ms).outcome.status == OutcomeStatus::ok);
-    }
-    SUBCASE("an arrival after the loop's time (clock skew) counts as the loop's time") {
-        s.master.on_bytes(read_model_reply, s.tx_end + 1ms, s.tx_end + 1s);
-        CHECK(expect_finished(s.master, s.tx_end + 1ms).outcome.status == OutcomeStatus::ok);
-    }
-}
-
 TEST_CASE("stream: on a serial line the same early bytes are framed (no stream rule there)") {
     fe::LineTimingConfig serial = stream_line();
     serial.stream = false;
