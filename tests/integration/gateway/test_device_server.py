@@ -195,7 +195,14 @@ class DeviceServerCell(gatewaylib.CellTestCase):
         self.assertEqual(self.meter(0), 111)
 
     def test_a_late_reply_is_never_matched_to_the_next_request(self):
-        # It arrives just after the next request was written.
+        # It arrives just after the next request was written. The gateway tells it by
+        # time: it came before the request could have left the device server (the
+        # request's wire time after the write). Under qemu-user the daemon handles the
+        # bytes milliseconds after they came, past that instant, so the rule cannot
+        # hold there (docs/configuration.md, "Lines on tcp:// ports": what a loop
+        # that reads late lets through); the merged case below needs no clock.
+        if emulation.emulated():
+            self.skipTest("a timing rule on the loop's clock: qemu-user's loop reads too late to see it")
         self.check_held_reply_not_matched("late")
 
     def test_two_replies_in_one_segment_the_newest_answers(self):
