@@ -440,6 +440,13 @@ class CellTestCase(unittest.TestCase):
         with open(self.config_path, "w", encoding="utf-8") as f:
             f.write(text.replace(old, new, 1))
 
+    def reload(self, timeout=15.0):
+        """SIGHUP to the gateway; returns once it logged that the reload was applied."""
+        mark = self.gateway.mark()
+        self.gateway.signal(signal.SIGHUP)
+        if self.gateway.wait_line(lambda line: "configuration reloaded" in line, timeout, start=mark) is None:
+            self.fail("reload not applied:\n%s" % self.gateway.text())
+
     def start_gateway(self, launcher=(), wait_ready=True):
         self.gateway = Process("fieldbridge", list(launcher) + target_command(GATEWAY, "--config", self.config_path),
                                self.path("gateway.log"), env=environment())

@@ -9,7 +9,6 @@ and the compiled-in definition stands in once the copy is gone."""
 
 import json
 import os
-import signal
 import struct
 
 import gatewaylib
@@ -197,10 +196,7 @@ class BuiltInDefinition(gatewaylib.CellTestCase):
         self.assert_exception(client.read_holding_registers(0x003D, count=1, slave=stepper), 0x02)
 
         os.remove(copy)
-        mark = self.gateway.mark()
-        self.gateway.signal(signal.SIGHUP)
-        if self.gateway.wait_line(lambda line: "configuration reloaded" in line, 10, start=mark) is None:
-            self.fail("reload not applied:\n%s" % self.gateway.text())
+        self.reload(timeout=10)
         client = self.client()
         self.wait_value(lambda: client.write_registers(0x0100, [0x0001, 0x86A1], slave=stepper).isError(), False, 5,
                         "abs 100001 accepted with the compiled-in definition")

@@ -816,12 +816,6 @@ class Reload(SparkplugCell):
         with open(os.path.join(self.definitions, "spb-meter.yaml"), "w", encoding="utf-8") as f:
             f.write(METER_DEFINITION.format(unit=unit))
 
-    def reload(self):
-        mark = len(self.gateway.text().splitlines())
-        self.gateway.signal(signal.SIGHUP)
-        if self.gateway.wait_line(lambda line: "configuration reloaded" in line, TIMEOUT, start=mark) is None:
-            self.fail("reload not applied:\n%s" % self.gateway.text())
-
     def assert_only(self, mark, expected):
         """From @p mark on, the births and deaths are exactly @p expected ((kind, device)
         pairs, in order)."""
