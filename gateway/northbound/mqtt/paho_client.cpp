@@ -262,12 +262,28 @@ PahoClient::~PahoClient() {
         // Tearing down: Paho may refuse when the connection is already gone.
     }
     if (leave_to_exit_ && !core_->connected_) {
-        // The process is ending and nothing is in flight (disconnected, callbacks
-        // off). Destroying Paho's last client runs MQTTAsync_terminate, which races
-        // the library's detached worker threads as they stop (paho.mqtt.c#1669): one
-        // TLS test run saw the send thread fault after "stopped". The handle stays
+        // The process is ending and the loop sees no connection (callbacks off).
+        // Destroying Paho's last client runs MQTTAsync_terminate, which races the
+        // library's detached worker threads as they stop (paho.mqtt.c#1669): one TLS
+        // test run saw the send thread fault after "stopped". The handle stays
         // reachable from Paho's own client list until exit; the kernel takes the rest.
-        static_cast<void>(core_->client_.release());
+        //
+        // A connect may still be in flight (the node walked to its next server just
+        // before SIGTERM): Paho then calls connect_listener_ when the CONNACK or the
+        // timeout comes, and its token keeps only a raw pointer to it. So the Core
+        // (every listener) lives as long as the handle: the handle holds it in a
+        // handler Paho calls at most before a reconnect (never: no automatic
+        // reconnect), and a late listener call finds the Core closed and posts nothing.
+        auto* leaked = core_->client_.release();
+        try {
+            leaked->set_update_connection_handler([anchor = core_](::mqtt::connect_data&) {
+                static_cast<void>(anchor);
+                return false;
+            });
+        } catch (...) {
+            // Paho refused the handler (out of memory): keep the Core by leaking it.
+            static_cast<void>(new std::shared_ptr<Core>(core_));
+        }
         return;
     }
     core_->client_.reset();
