@@ -1,4 +1,4 @@
-# Sourced (not run) by deploy/run-tests, deploy/build-deb and tests/fuzz/run-fuzzers
+# Sourced (not run) by deploy/run-tests, deploy/run-demo, deploy/build-deb and tests/fuzz/run-fuzzers
 # before they configure a new build directory on this machine: the compilers run
 # through ccache (docs/build.md, "Compiler cache"), one cache per machine in
 # /var/cache/fieldbridge/ccache/host, shared by the sanitizer, fuzz, cross and package
