@@ -99,6 +99,9 @@ void set(T& target, const Field<T>& field) {
         if (definition != nullptr) {  // a file replaces the compiled-in definition
             device.definition_file = definition->file;
             device.registers = build_registers(*definition);
+            if (!definition->points.absent()) {
+                device.builtin_state = build_point_model(definition, nullptr, point_defaults(definition, nullptr));
+            }
         }
         return device;
     }

@@ -31,6 +31,8 @@ namespace {
     point.max = raw.max.value;
     point.period = raw.period.value_or(defaults.period);
     point.deadband = raw.deadband.value;
+    point.invert = raw.invert.value_or(false);
+    point.format = raw.format.value_or(core::PointFormat::number);
     return point;
 }
 
@@ -58,6 +60,7 @@ namespace {
     alarm.hysteresis = raw.hysteresis.value_or(0.0);
     alarm.severity = raw.severity.value_or(core::AlarmSeverity::warning);
     alarm.text = raw.text.value_or("");
+    alarm.source = raw.source.value_or("");
     return alarm;
 }
 

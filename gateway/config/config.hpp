@@ -210,6 +210,11 @@ struct DeviceConfig {
     /// compiled-in one (docs/devices.md, "Built-in types"); empty when the compiled-in
     /// definition is used, and for generic devices.
     std::vector<core::RegisterDef> registers;
+    /// Built-in types: the points and alarms of the definition file that decode the
+    /// hook's state (docs/devices.md, "Built-in types"); nullopt when the compiled-in
+    /// definition's apply (no file, or a file without points:). Not `points`: a
+    /// built-in type's fields are not written or read by name over MQTT.
+    std::optional<core::PointModel> builtin_state = std::nullopt;
     /// Generic devices: the poll period of points (and blocks) that set none.
     milliseconds period = seconds{1};
     /// Registers (bits) no point names that one merged read may bridge.

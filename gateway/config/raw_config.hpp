@@ -142,6 +142,8 @@ struct RawPoint : RawNode {
     Field<double> max;
     Field<std::chrono::milliseconds> period;
     Field<double> deadband;
+    Field<bool> invert;
+    Field<core::PointFormat> format;
 };
 
 struct RawAlarm : RawNode {
@@ -155,6 +157,7 @@ struct RawAlarm : RawNode {
     Field<double> hysteresis;
     Field<core::AlarmSeverity> severity;
     Field<std::string> text;
+    Field<std::string> source;
 };
 
 struct RawIdentify : RawNode {

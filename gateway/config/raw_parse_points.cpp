@@ -35,7 +35,7 @@ RawEnum parse_enum(const NodeRef& ref, DiagnosticSink& sink) {
 RawPoint parse_point(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "table", "address", "type", "bit", "count", "word_order", "byte_order", "scale",
-                         "offset", "unit", "enum", "writable", "min", "max", "period", "deadband"},
+                         "offset", "unit", "enum", "writable", "min", "max", "period", "deadband", "invert", "format"},
                         sink);
     RawPoint raw;
     map.fill(raw);
@@ -56,13 +56,15 @@ RawPoint parse_point(const NodeRef& ref, DiagnosticSink& sink) {
     raw.max = read_number(map, "max");
     raw.period = read_duration(map, "period");
     raw.deadband = read_number(map, "deadband");
+    raw.invert = read_bool(map, "invert");
+    raw.format = read_enum(map, "format", core::point_format_names);
     return raw;
 }
 
 RawAlarm parse_alarm(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "point", "above", "below", "equals", "not_equals", "bit", "hysteresis", "severity",
-                         "text"},
+                         "text", "source"},
                         sink);
     RawAlarm raw;
     map.fill(raw);
@@ -76,6 +78,7 @@ RawAlarm parse_alarm(const NodeRef& ref, DiagnosticSink& sink) {
     raw.hysteresis = read_number(map, "hysteresis");
     raw.severity = read_enum(map, "severity", core::alarm_severity_names);
     raw.text = read_string(map, "text");
+    raw.source = read_string(map, "source");
     return raw;
 }
 

@@ -129,6 +129,32 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
         refuse_for_type(sink, point.deadband, "deadband", type, "numeric points");
     }
     check_labels(point, type, sink);
+    if (point.invert.has_value() && type != PointType::boolean) {
+        sink.error(point.invert, "invert applies only to bool points (this point is " + type_text(type) +
+                                     "); remove it");
+    }
+    if (point.format.has_value() && *point.format == core::PointFormat::hex) {
+        if (!is_integer(type)) {
+            sink.error(point.format, "format: hex applies only to integer points (this point is " + type_text(type) +
+                                         "); remove it");
+        } else {
+            // The text shows the registers as they are: nothing to scale, label or write.
+            for (const auto* key : {&point.scale, &point.offset, &point.min, &point.max, &point.deadband}) {
+                if (key->has_value()) {
+                    sink.error(*key, "a point with format: hex shows its registers as a text; remove this key "
+                                     "(or the format)");
+                }
+            }
+            if (!point.labels.absent()) {
+                sink.error(point.labels, "a point with format: hex shows its registers as a text, not a label; "
+                                         "remove enum (or the format)");
+            }
+            if (point.writable.value_or(false)) {
+                sink.error(point.writable, "a point with format: hex is read-only; expected writable: false (or "
+                                           "remove the format to write it as a number)");
+            }
+        }
+    }
     if (point.writable.value_or(false) && point.table.has_value() &&
         (*point.table == RegisterTable::input || *point.table == RegisterTable::discrete_inputs)) {
         sink.error(point.writable, "table " + std::string(core::to_string(*point.table)) +
@@ -144,6 +170,29 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
     }
     check_range(sink, point.period, RegisterBlock::period_range);
     return shape_ok;
+}
+
+/// `text:` may name the point's value as {value}; any other brace is a typo. `source:`
+/// is one line for operators.
+void check_alarm_text(const RawAlarm& alarm, DiagnosticSink& sink) {
+    if (alarm.text.has_value()) {
+        std::string_view rest = *alarm.text;
+        for (std::size_t at = rest.find_first_of("{}"); at != std::string_view::npos; at = rest.find_first_of("{}")) {
+            if (rest.substr(at).starts_with(core::AlarmRule::value_placeholder)) {
+                rest.remove_prefix(at + core::AlarmRule::value_placeholder.size());
+                continue;
+            }
+            sink.error(alarm.text, "the text has a brace that is not {value}; expected {value} (the point's value "
+                                   "when the alarm is raised) or no braces");
+            break;
+        }
+    }
+    if (alarm.source.has_value() &&
+        (alarm.source->empty() || alarm.source->size() > 128 ||
+         std::any_of(alarm.source->begin(), alarm.source->end(), [](char c) { return c < 0x20 || c == 0x7F; }))) {
+        sink.error(alarm.source, "expected one line of up to 128 characters naming where the alarm comes from, "
+                                 "e.g. holding 0x02D6 (without source: the point's name)");
+    }
 }
 
 [[nodiscard]] std::string where_of(const PointSpan& span) {
@@ -283,6 +332,7 @@ std::vector<std::string> check_alarms(const RawSeq<RawAlarm>& alarms, const std:
                                   "; expected exactly one of above, below, equals, not_equals, bit");
         }
         check_range(sink, alarm.bit, Range<std::int64_t>{0, 63});
+        check_alarm_text(alarm, sink);
         if (alarm.hysteresis.has_value() && *alarm.hysteresis < 0) {
             sink.error(alarm.hysteresis, "expected a number >= 0 (how far back past the threshold clears it)");
         }

@@ -19,6 +19,7 @@ struct RowSpan {
     std::int64_t first = 0;
     std::int64_t last = 0;
     std::string path;
+    bool readable = true;
 };
 
 /// The value range a row of @p width can hold: 16 bits, or a 32-bit pair either
@@ -74,7 +75,47 @@ std::optional<RowSpan> check_register(const RawRegister& row, DiagnosticSink& si
                                   "); expected address + width x count - 1 <= 0xFFFF");
         return std::nullopt;
     }
-    return RowSpan{row.table.value_or(RegisterTable::holding), *row.address, last, row.path};
+    return RowSpan{row.table.value_or(RegisterTable::holding), *row.address, last, row.path,
+                   !row.access.has_value() || core::can_read(*row.access)};
+}
+
+/// A built-in type's points name what its hook polls: keys that say how to poll or
+/// write a point are the hook's, and every register of a point is a readable row.
+void check_builtin_point(const RawPoint& point, const std::vector<RowSpan>& rows, std::string_view hook,
+                         DiagnosticSink& sink) {
+    for (const auto& [field, key] : {std::pair{&point.min, "min"}, std::pair{&point.max, "max"}}) {
+        if (field->has_value()) {
+            sink.error(*field, std::string(key) + " limits writes, and a built-in type is written through its "
+                                                  "registers: (min / max of the row) and its hook's ops; remove it");
+        }
+    }
+    if (point.writable.has_value()) {
+        sink.error(point.writable, "a built-in type's points are read-only (writes go through its registers: and "
+                                   "the ops of its hook); remove writable");
+    }
+    if (point.period.has_value()) {
+        sink.error(point.period, "a built-in type polls with the device's poll: periods; remove period");
+    }
+    if (!point.ok() || !point.table.has_value() || !point.address.has_value() || point.type.invalid ||
+        point.count.invalid) {
+        return;  // reported by check_points()
+    }
+    const core::PointType type = effective_type(point);
+    const std::int64_t width = core::is_bit_table(*point.table)
+                                   ? 1
+                                   : core::registers_of(type, static_cast<std::uint16_t>(point.count.value_or(0)));
+    for (std::int64_t address = *point.address; address < *point.address + width; ++address) {
+        const auto row = std::find_if(rows.begin(), rows.end(), [&](const RowSpan& r) {
+            return r.table == *point.table && r.first <= address && address <= r.last;
+        });
+        if (row == rows.end() || !row->readable) {
+            sink.error(point.address, std::string(core::to_string(*point.table)) + " " + hex16(address) +
+                                          (row == rows.end() ? " is in no row of registers:" : " is write-only in " + row->path) +
+                                          "; a point of " + std::string(hook) +
+                                          " decodes what its hook polls: expected a readable row there");
+            return;
+        }
+    }
 }
 
 }  // namespace
@@ -91,12 +132,12 @@ void check_registers(const RawDefinition& definition, DiagnosticSink& sink) {
         }
         return;
     }
-    for (const RawNode* generic : std::initializer_list<const RawNode*>{&definition.points, &definition.alarms,
-                                                                         &definition.blocks, &definition.identify}) {
+    const std::string hook(core::to_string(*definition.behaviour));
+    for (const RawNode* generic : std::initializer_list<const RawNode*>{&definition.blocks, &definition.identify}) {
         if (!generic->absent()) {
-            sink.error(*generic, "a definition with behaviour: " + std::string(core::to_string(*definition.behaviour)) +
-                                     " describes its registers:; its state, alarms and scan are its hook's: remove "
-                                     "this key (points, alarms, blocks and identify are for generic devices)");
+            sink.error(*generic, "a definition with behaviour: " + hook +
+                                     " describes its registers:; what it polls and how scan finds it are its "
+                                     "hook's: remove this key (blocks and identify are for generic devices)");
         }
     }
     if (!definition.max_gap.absent()) {
@@ -132,6 +173,9 @@ void check_registers(const RawDefinition& definition, DiagnosticSink& sink) {
             continue;
         }
         spans.push_back(*span);
+    }
+    for (const RawPoint& point : definition.points.items) {
+        check_builtin_point(point, spans, hook, sink);
     }
 }
 

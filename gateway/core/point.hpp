@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -79,6 +80,20 @@ struct Names<ByteOrder> {
     static constexpr const auto& table = byte_order_names;
 };
 
+/// How an integer point's value is shown (`format:`): a number, or its registers as
+/// one hexadecimal text, "0x" and four upper-case digits per register ("0x00000078"
+/// for a uint32), for identifiers and versions that are codes rather than amounts.
+enum class PointFormat : std::uint8_t { number, hex };
+
+inline constexpr NameTable<PointFormat, 2> point_format_names{{
+    {"number", PointFormat::number},
+    {"hex", PointFormat::hex},
+}};
+template <>
+struct Names<PointFormat> {
+    static constexpr const auto& table = point_format_names;
+};
+
 /// One label of an enumerated point: raw value -> label.
 struct EnumLabel {
     std::int64_t value = 0;
@@ -104,6 +119,8 @@ struct PointDef {
     std::optional<double> max;
     std::chrono::milliseconds period{1000};
     std::optional<double> deadband;  ///< MQTT, engineering units
+    bool invert = false;                        ///< bool points: true while the bit (coil) is 0
+    PointFormat format = PointFormat::number;  ///< integer points: `hex` shows a text
 
     /// Registers (or bits) the point spans.
     [[nodiscard]] std::uint16_t width() const noexcept {
@@ -144,6 +161,8 @@ struct Names<AlarmSeverity> {
 /// holds by `hysteresis` (above: value <= threshold - hysteresis; below: value >=
 /// threshold + hysteresis; equals / not_equals / bit: as soon as it no longer holds).
 struct AlarmRule {
+    /// Where `text` shows the point's value (as the state shows it) at the time.
+    static constexpr std::string_view value_placeholder = "{value}";
     std::string name;   ///< the alarm's code on MQTT
     std::string point;  ///< a point of the device
     AlarmCondition condition = AlarmCondition::above;
@@ -151,7 +170,8 @@ struct AlarmRule {
     std::uint8_t bit = 0;  ///< condition `bit`: raised while this bit of the raw value is 1
     double hysteresis = 0;
     AlarmSeverity severity = AlarmSeverity::warning;
-    std::string text;  ///< for operators; the rule's name when empty
+    std::string text;    ///< for operators, `{value}` replaced by the point's value; when empty, made from the rule
+    std::string source;  ///< what the alarm names as its source; "point <point>" when empty
     bool operator==(const AlarmRule&) const = default;
 };
 

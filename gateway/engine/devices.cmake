@@ -12,6 +12,7 @@ add_library(fb_engine_devices STATIC
   ${CMAKE_CURRENT_LIST_DIR}/profiles/register_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/modbus_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/builtin_map.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/profiles/point_state.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/xeg_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/excd_profile.cpp
   ${CMAKE_CURRENT_LIST_DIR}/profiles/wtec_common.cpp

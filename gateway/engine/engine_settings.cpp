@@ -87,6 +87,7 @@ ProfileOptions profile_options(const config::DeviceConfig& device) {
     }
     options.points = device.points;
     options.registers = device.registers;
+    options.builtin_state = device.builtin_state;
     return options;
 }
 

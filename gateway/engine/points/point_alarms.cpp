@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <optional>
+#include <string_view>
+#include <utility>
 
 #include "engine/points/point_codec.hpp"
 
@@ -13,6 +15,11 @@ using core::AlarmCondition;
 
 /// The number an alarm compares: an enum's code, a bool's 0 / 1, the engineering value.
 [[nodiscard]] std::optional<double> compared(const core::PointDef& point, std::span<const std::uint16_t> registers) {
+    if (point.format == core::PointFormat::hex) {
+        // Shown as a text, compared as the integer it is.
+        const std::optional<std::int64_t> raw = raw_integer(point, registers);
+        return raw ? std::optional<double>{static_cast<double>(*raw)} : std::nullopt;
+    }
     const PointValue value = decode(point, registers);
     if (const auto* b = std::get_if<bool>(&value)) return *b ? 1.0 : 0.0;
     if (const auto* i = std::get_if<std::int64_t>(&value)) return static_cast<double>(*i);
@@ -29,7 +36,21 @@ using core::AlarmCondition;
     return point.unit.empty() ? number : number + " " + point.unit;
 }
 
+/// The value as the JSON state shows it, as plain text.
+[[nodiscard]] std::string shown_text(const core::PointDef& point, std::span<const std::uint16_t> registers) {
+    PointValue value = decode(point, registers);
+    if (const auto* code = std::get_if<std::int64_t>(&value); code != nullptr && !point.labels.empty()) {
+        if (const std::string_view label = label_of(point, *code); !label.empty()) return std::string{label};
+    }
+    if (auto* text = std::get_if<std::string>(&value)) return std::move(*text);
+    return to_text(value);
+}
+
 }  // namespace
+
+std::string alarm_source(const core::AlarmRule& rule) {
+    return rule.source.empty() ? "point " + rule.point : rule.source;
+}
 
 bool alarm_raised(const core::AlarmRule& rule, const core::PointDef& point, std::span<const std::uint16_t> registers,
                   bool was_raised) {
@@ -53,9 +74,17 @@ bool alarm_raised(const core::AlarmRule& rule, const core::PointDef& point, std:
     return false;
 }
 
-std::string alarm_text(const core::AlarmRule& rule, const core::PointDef& point) {
+std::string alarm_text(const core::AlarmRule& rule, const core::PointDef& point,
+                       std::span<const std::uint16_t> registers) {
     if (!rule.text.empty()) {
-        return rule.text;
+        const std::string_view placeholder = core::AlarmRule::value_placeholder;
+        std::string text;
+        std::string_view rest = rule.text;
+        for (std::size_t at = rest.find(placeholder); at != std::string_view::npos; at = rest.find(placeholder)) {
+            text.append(rest.substr(0, at)).append(shown_text(point, registers));
+            rest.remove_prefix(at + placeholder.size());
+        }
+        return text.append(rest);
     }
     switch (rule.condition) {
         case AlarmCondition::above: return point.name + " above " + threshold_text(rule, point);

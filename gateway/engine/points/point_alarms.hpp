@@ -21,8 +21,14 @@ namespace fieldbridge::engine::points {
 [[nodiscard]] bool alarm_raised(const core::AlarmRule& rule, const core::PointDef& point,
                                 std::span<const std::uint16_t> registers, bool was_raised);
 
-/// The rule's text, or one naming the point, the condition and the threshold
+/// The rule's text with each `{value}` replaced by the point's value as the state shows
+/// it (an enum's label, a text without quotes: "the controller reports alarm code 7"),
+/// or, without a text, one naming the point, the condition and the threshold
 /// ("temperature above 80 °C", "bit 3 of status set").
-[[nodiscard]] std::string alarm_text(const core::AlarmRule& rule, const core::PointDef& point);
+[[nodiscard]] std::string alarm_text(const core::AlarmRule& rule, const core::PointDef& point,
+                                     std::span<const std::uint16_t> registers);
+
+/// What the alarm names as its source: the rule's `source`, else "point <name>".
+[[nodiscard]] std::string alarm_source(const core::AlarmRule& rule);
 
 }  // namespace fieldbridge::engine::points

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <string_view>
 #include <type_traits>
 
 namespace fieldbridge::engine::points {
@@ -89,6 +90,16 @@ struct RawInteger {
         default: break;
     }
     return r;
+}
+
+/// "0x" and four upper-case hex digits for each of @p registers (format: hex).
+[[nodiscard]] std::string hex_text(std::uint64_t bits, std::uint16_t registers) {
+    static constexpr std::string_view digits = "0123456789ABCDEF";
+    std::string text = "0x";
+    for (int shift = 4 * 4 * registers - 4; shift >= 0; shift -= 4) {
+        text += digits[(bits >> shift) & 0xFU];
+    }
+    return text;
 }
 
 [[nodiscard]] std::string decode_string(const PointDef& p, std::span<const std::uint16_t> registers) {
@@ -279,15 +290,16 @@ struct TypeRange {
 PointValue decode(const PointDef& point, std::span<const std::uint16_t> registers) {
     const std::uint16_t first = registers.empty() ? std::uint16_t{0} : registers.front();
     if (point.is_bool()) {
-        if (is_bit_point(point)) {
-            return *point.bit < 16 && ((first >> *point.bit) & 1U) != 0;
-        }
-        return first != 0;
+        const bool set = is_bit_point(point) ? *point.bit < 16 && ((first >> *point.bit) & 1U) != 0 : first != 0;
+        return set != point.invert;
     }
     if (point.type == PointType::string) {
         return decode_string(point, registers);
     }
     const std::uint64_t bits = raw_bits(point, registers);
+    if (point.format == core::PointFormat::hex) {
+        return hex_text(bits, point.width());
+    }
     if (point.type == PointType::float32) {
         return engineering(point, static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(bits))));
     }
@@ -324,13 +336,14 @@ Encoded encode(const PointDef& point, const PointValue& value) {
         if (b == nullptr) {
             return refused("it takes true or false, not " + std::string{kind_of(value)});
         }
+        const bool set = *b != point.invert;
         if (is_bit_point(point)) {
             if (*point.bit > 15) {
                 return refused("its bit " + std::to_string(*point.bit) + " is outside 0-15");
             }
-            return Encoded{{static_cast<std::uint16_t>(*b ? 1U << *point.bit : 0U)}, {}};
+            return Encoded{{static_cast<std::uint16_t>(set ? 1U << *point.bit : 0U)}, {}};
         }
-        return Encoded{{static_cast<std::uint16_t>(*b ? 1 : 0)}, {}};
+        return Encoded{{static_cast<std::uint16_t>(set ? 1 : 0)}, {}};
     }
     if (point.type == PointType::string) {
         const auto* s = std::get_if<std::string>(&value);

@@ -75,6 +75,9 @@ struct ProfileOptions {
     /// Built-in types: the register map of a definition file that replaced the
     /// compiled-in one; empty: the compiled-in definition's (builtin_map.hpp).
     std::vector<core::RegisterDef> registers;
+    /// Built-in types: the points and alarms of a definition file that decode the
+    /// state; nullopt: the compiled-in definition's (builtin_map.hpp).
+    std::optional<core::PointModel> builtin_state = std::nullopt;
 };
 
 /// Options a profile cannot work with; what() names the option and the fix.

@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "engine/profiles/builtin_map.hpp"
-#include "engine/profiles/profile_text.hpp"
 
 namespace fieldbridge::engine {
 
@@ -25,14 +24,9 @@ constexpr std::uint16_t excd_stop = 0x0108;
 constexpr std::uint16_t excd_mstop = 0x0109;
 constexpr std::uint16_t jog = 0x010A;
 constexpr std::uint16_t excd_jog_stop = 0x010C;
-constexpr std::uint16_t rabs = 0x0201;
-constexpr std::uint16_t rin = 0x0203;
-constexpr std::uint16_t rout = 0x0204;
 constexpr std::uint16_t rby = 0x0205;  // 0 busy, 1 not busy
-constexpr std::uint16_t sensor = 0x0206;
 constexpr std::uint16_t ver = 0x0207;
-constexpr std::uint16_t renc = 0x02D4;
-constexpr std::uint16_t ralarm = 0x02D6;
+constexpr std::uint16_t renc = 0x02D4;  // renc, then ralarm 0x02D6
 
 [[nodiscard]] WireFunctions excd_wire_functions() {
     // Seed 002 §2: FC03, FC06, FC10 only.
@@ -74,15 +68,6 @@ constexpr std::uint16_t ralarm = 0x02D6;
     return table;
 }
 
-[[nodiscard]] std::optional<std::int64_t> pair_in(const RegisterImage& image, std::uint16_t address, bool is_signed) {
-    const auto high = image.value(Table::holding, address);
-    const auto low = image.value(Table::holding, static_cast<std::uint16_t>(address + 1));
-    if (!high || !low) {
-        return std::nullopt;
-    }
-    return pair_value(*high, *low, is_signed);
-}
-
 }  // namespace
 
 IdentificationRead excd_identification() noexcept { return IdentificationRead{ver, 2}; }
@@ -91,7 +76,8 @@ OperationSet excd_operations() { return OperationSet{"excd", excd_operation_tabl
 
 ExcdProfile::ExcdProfile(const ProfileOptions& options)
     : ModbusProfile(builtin_register_map(DeviceType::excd203mb, options), excd_wire_functions(), options,
-                    options.word_order) {}
+                    options.word_order),
+      state_(builtin_state_points(DeviceType::excd203mb, options)) {}
 
 std::optional<ExceptionCode> ExcdProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
                                                       std::int64_t value, const RegisterImage& /*image*/) const {
@@ -122,46 +108,11 @@ bool ExcdProfile::in_motion(const RegisterImage& image) const {
 }
 
 DecodedState ExcdProfile::decode_state(const RegisterImage& image) const {
-    DecodedState state;
-    if (const auto p = pair_in(image, rabs, true)) {
-        state.fields.push_back({"position", *p, "pulse"});
-    }
-    if (const auto e = pair_in(image, renc, true)) {
-        state.fields.push_back({"encoder", *e, "count"});
-    }
-    if (const auto b = image.value(Table::holding, rby)) {
-        state.fields.push_back({"busy", *b == 0, ""});
-    }
-    if (const auto in = image.value(Table::holding, rin)) {
-        state.fields.push_back({"inputs", std::int64_t{*in}, ""});
-    }
-    if (const auto out = image.value(Table::holding, rout)) {
-        state.fields.push_back({"outputs", std::int64_t{*out}, ""});
-    }
-    if (const auto s = image.value(Table::holding, sensor)) {
-        state.fields.push_back({"sensor", std::int64_t{*s}, ""});
-    }
-    if (const auto a = image.value(Table::holding, ralarm)) {
-        state.fields.push_back({"alarm_code", std::int64_t{*a}, ""});
-    }
-    if (const auto v = pair_in(image, ver, false)) {
-        // The manual does not say how ver is coded: shown as its hex value.
-        const auto raw = static_cast<std::uint32_t>(*v);
-        state.fields.push_back(
-            {"version", hex_word(static_cast<std::uint16_t>(raw >> 16)) + hex_word(static_cast<std::uint16_t>(raw)).substr(2),
-             ""});
-    }
-    return state;
+    return state_.decode(image);
 }
 
 std::vector<Alarm> ExcdProfile::alarms(const RegisterImage& image) const {
-    std::vector<Alarm> out;
-    if (const auto a = image.value(Table::holding, ralarm); a && *a != 0) {
-        out.push_back(Alarm{"alarm", "the controller reports alarm code " + std::to_string(*a) +
-                                         " (ralarm 0x02D6); see the EXCD203MB manual and clear it at the controller",
-                            Severity::error, "holding 0x02D6"});
-    }
-    return out;
+    return state_.alarms(image);
 }
 
 }  // namespace fieldbridge::engine

@@ -9,11 +9,14 @@
 /// directions, and widens reads that cut a pair. Broadcast address 0xFF (§5).
 /// Protected (refused with 0x01 unless allow_protected): idon 0x001F, id 0x0020,
 /// baude 0x002B, mbus 0x003A, save 0x0303.
+/// State fields and the alarm: the points and alarms of its definition
+/// (config/devices/excd203mb.yaml).
 
 #include <cstdint>
 #include <optional>
 
 #include "engine/profiles/modbus_profile.hpp"
+#include "engine/profiles/point_state.hpp"
 
 namespace fieldbridge::engine {
 
@@ -42,6 +45,8 @@ private:
                                                                      std::int64_t value,
                                                                      const RegisterImage& image) const override;
     [[nodiscard]] std::vector<PollUnit> poll_units() const override;
+
+    PointState state_;
 };
 
 }  // namespace fieldbridge::engine

@@ -5,7 +5,6 @@
 #include <string>
 #include <utility>
 
-#include "engine/points/point_alarms.hpp"
 #include "engine/points/point_codec.hpp"
 
 namespace fieldbridge::engine {
@@ -23,20 +22,6 @@ namespace {
                          false, false};
 }
 
-[[nodiscard]] Severity severity_of(core::AlarmSeverity s) noexcept {
-    switch (s) {
-        case core::AlarmSeverity::warning: return Severity::warning;
-        case core::AlarmSeverity::error: return Severity::error;
-        case core::AlarmSeverity::critical: return Severity::critical;
-    }
-    return Severity::error;
-}
-
-[[nodiscard]] FieldValue field_value(points::PointValue value) {
-    return std::visit([](auto&& v) -> FieldValue { return FieldValue{std::forward<decltype(v)>(v)}; },
-                      std::move(value));
-}
-
 }  // namespace
 
 GenericProfile::GenericProfile(const ProfileOptions& options)
@@ -45,14 +30,7 @@ GenericProfile::GenericProfile(const ProfileOptions& options)
 GenericProfile::GenericProfile(const ProfileOptions& options, GenericMap map)
     : ModbusProfile(std::move(map.map), generic_wire_functions(), options, WordOrder::high_first),
       units_(std::move(map.units)),
-      raised_(options.points.alarms.size(), false) {
-    const auto& points = this->options().points.points;
-    for (const core::AlarmRule& rule : this->options().points.alarms) {
-        const auto it = std::find_if(points.begin(), points.end(),
-                                     [&rule](const core::PointDef& p) { return p.name == rule.point; });
-        alarm_points_.push_back(static_cast<std::size_t>(it - points.begin()));  // found: build_generic_map()
-    }
-}
+      state_(options.points) {}
 
 std::optional<protocol::ExceptionCode> GenericProfile::validate(const protocol::Request& request,
                                                                 const RegisterImage& image) const {
@@ -108,64 +86,16 @@ std::vector<PollUnit> GenericProfile::poll_units() const {
     return units;
 }
 
-std::vector<std::uint16_t> GenericProfile::registers_of(const RegisterImage& image, std::size_t index) const {
-    const core::PointDef& p = options().points.points[index];
-    std::vector<std::uint16_t> out;
-    out.reserve(p.width());
-    for (std::size_t k = 0; k < p.width(); ++k) {
-        const std::optional<std::uint16_t> v = image.value(p.table, static_cast<std::uint16_t>(p.address + k));
-        if (!v) {
-            return {};
-        }
-        out.push_back(*v);
-    }
-    return out;
-}
-
 bool GenericProfile::in_motion(const RegisterImage& /*image*/) const {
     return false;
 }
 
 DecodedState GenericProfile::decode_state(const RegisterImage& image) const {
-    DecodedState state;
-    const auto& points = options().points.points;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const core::PointDef& p = points[i];
-        const std::vector<std::uint16_t> registers = registers_of(image, i);
-        if (registers.empty()) {
-            continue;
-        }
-        points::PointValue value = points::decode(p, registers);
-        if (!p.labels.empty()) {
-            if (const auto* code = std::get_if<std::int64_t>(&value)) {
-                const std::string_view label = points::label_of(p, *code);
-                // A code the enum does not name: the code stands in for the label.
-                state.fields.push_back(label.empty() ? Field{p.name, *code, p.unit}
-                                                     : Field{p.name, std::string{label}, p.unit});
-                state.fields.push_back(Field{p.name + "_code", *code, ""});
-                continue;
-            }
-        }
-        state.fields.push_back(Field{p.name, field_value(std::move(value)), p.unit});
-    }
-    return state;
+    return state_.decode(image);
 }
 
 std::vector<Alarm> GenericProfile::alarms(const RegisterImage& image) const {
-    const core::PointModel& point_model = options().points;
-    std::vector<Alarm> out;
-    const std::lock_guard lock(alarm_mutex_);
-    for (std::size_t r = 0; r < point_model.alarms.size(); ++r) {
-        const core::AlarmRule& rule = point_model.alarms[r];
-        const core::PointDef& point = point_model.points[alarm_points_[r]];
-        const std::vector<std::uint16_t> registers = registers_of(image, alarm_points_[r]);
-        raised_[r] = !registers.empty() && points::alarm_raised(rule, point, registers, raised_[r]);
-        if (raised_[r]) {
-            out.push_back(Alarm{rule.name, points::alarm_text(rule, point), severity_of(rule.severity),
-                                "point " + point.name});
-        }
-    }
-    return out;
+    return state_.alarms(image);
 }
 
 }  // namespace fieldbridge::engine

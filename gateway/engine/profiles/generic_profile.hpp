@@ -18,12 +18,11 @@
 /// no MQTT operations of its own (the raw register ops, and the point ops MQTT
 /// derives from the points).
 
-#include <cstddef>
-#include <mutex>
 #include <vector>
 
 #include "engine/profiles/generic_map.hpp"
 #include "engine/profiles/modbus_profile.hpp"
+#include "engine/profiles/point_state.hpp"
 
 namespace fieldbridge::engine {
 
@@ -56,13 +55,9 @@ public:
 private:
     GenericProfile(const ProfileOptions& options, GenericMap map);
     [[nodiscard]] std::vector<PollUnit> poll_units() const override;
-    /// The registers of point @p index from the image; empty when one is unknown.
-    [[nodiscard]] std::vector<std::uint16_t> registers_of(const RegisterImage& image, std::size_t index) const;
 
     std::vector<PointUnit> units_;
-    std::vector<std::size_t> alarm_points_;  ///< per alarm rule: the index of its point
-    mutable std::mutex alarm_mutex_;
-    mutable std::vector<bool> raised_;  ///< per alarm rule: raised at the last alarms()
+    PointState state_;
 };
 
 }  // namespace fieldbridge::engine

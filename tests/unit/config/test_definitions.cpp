@@ -451,21 +451,71 @@ TEST_CASE("an unknown behaviour hook is refused with the known ones") {
     CHECK(diagnostics.size() == 2);  // and the device's line that names the definition
 }
 
-TEST_CASE("behaviour: takes registers, not points; registers need behaviour:") {
+TEST_CASE("behaviour: takes registers, and points of them for its state; not blocks or identify") {
     const fieldbridge::test::TempDir dir("fb-definitions");
     const auto hook = dir.path() / "devices" / "hook.yaml";
     write_file(hook, "name: hook\n"
                      "behaviour: excd203mb\n"
-                     "registers: [{name: x, address: 0, access: read}]\n"
-                     "points: [{name: y, table: holding, address: 1}]\n");
-    require_diagnostic(diagnostics_in(dir.path() / "gw.yaml", config_text("hook", "", "definitions: [devices]\n")),
-                       hook, 4, 9, {"describes its registers:", "remove this key"});
+                     "registers: [{name: x, address: 0, access: read}, {name: w, address: 2, access: write}]\n"
+                     "blocks: [{table: holding, address: 0, count: 1}]\n"
+                     "points:\n"
+                     "  - {name: y, table: holding, address: 1}\n"
+                     "  - {name: z, table: holding, address: 2}\n"
+                     "  - {name: v, table: holding, address: 0, writable: true, min: 0, period: 2s}\n"
+                     "  - {name: u, table: input, address: 0}\n");
+    const auto diagnostics = diagnostics_in(dir.path() / "gw.yaml", config_text("hook", "", "definitions: [devices]\n"));
+    require_diagnostic(diagnostics, hook, 4, 9, {"describes its registers:", "remove this key"});
+    require_diagnostic(diagnostics, hook, 6, 40, {"holding 0x0001 is in no row of registers:", "readable row"});
+    require_diagnostic(diagnostics, hook, 7, 40, {"holding 0x0002 is write-only in registers[1]"});
+    require_diagnostic(diagnostics, hook, 8, 53, {"read-only", "remove writable"});
+    require_diagnostic(diagnostics, hook, 8, 64, {"min limits writes", "remove it"});
+    require_diagnostic(diagnostics, hook, 8, 75, {"poll: periods", "remove period"});
+    require_diagnostic(diagnostics, hook, 9, 38, {"input 0x0000 is in no row of registers:"});
     const auto generic = dir.path() / "devices" / "generic.yaml";
     write_file(generic, "name: generic\n"
                         "points: [{name: y, table: holding, address: 1}]\n"
                         "registers: [{name: x, address: 0, access: read}]\n");
     require_diagnostic(diagnostics_in(dir.path() / "gw.yaml", config_text("generic", "", "definitions: [devices]\n")),
                        generic, 3, 12, {"without behaviour: is a generic device"});
+}
+
+TEST_CASE("excd203mb's state is points of its definition: the fields and the alarm of docs/mqtt.md") {
+    const DeviceDefinition* excd = builtin_definition(DeviceType::excd203mb);
+    REQUIRE(excd != nullptr);
+    std::vector<std::string> names;
+    for (const auto& point : excd->points.points) names.push_back(point.name);
+    CHECK(names == std::vector<std::string>{"position", "encoder", "busy", "inputs", "outputs", "sensor",
+                                            "alarm_code", "version"});
+    const auto& busy = excd->points.points.at(2);
+    CHECK(busy.invert);
+    CHECK(busy.bit == 0);
+    CHECK(excd->points.points.at(7).format == fieldbridge::core::PointFormat::hex);
+    REQUIRE(excd->points.alarms.size() == 1);
+    const auto& alarm = excd->points.alarms.front();
+    CHECK(alarm.name == "alarm");
+    CHECK(alarm.condition == AlarmCondition::not_equals);
+    CHECK(alarm.severity == fieldbridge::core::AlarmSeverity::error);
+    CHECK(alarm.source == "holding 0x02D6");
+}
+
+TEST_CASE("an operator's copy with points: replaces the compiled-in state; one without keeps it") {
+    const fieldbridge::test::TempDir dir("fb-definitions");
+    const auto copy = dir.path() / "devices" / "excd203mb.yaml";
+    const std::string shipped = shipped_text("excd203mb");
+    write_file(copy, replaced(shipped, "{name: sensor, table: holding, address: 0x0206}",
+                              "{name: sensor, table: holding, address: 0x0206, unit: mV}"));
+    auto config = load_in(dir.path() / "gw.yaml", config_text("excd203mb", "", "definitions: [devices]\n"));
+    const auto& state = config->lines.at(0).devices.at(0).builtin_state;
+    REQUIRE(state.has_value());
+    CHECK(state->points.at(5).name == "sensor");
+    CHECK(state->points.at(5).unit == "mV");
+    CHECK(state->alarms.size() == 1);
+
+    // A copy made before the state was data (registers only): the compiled-in state.
+    write_file(copy, shipped.substr(0, shipped.find("\npoints:")) + "\n");
+    config = load_in(dir.path() / "gw.yaml", config_text("excd203mb", "", "definitions: [devices]\n"));
+    CHECK_FALSE(config->lines.at(0).devices.at(0).builtin_state.has_value());
+    CHECK(config->lines.at(0).devices.at(0).registers.size() == 77);
 }
 
 TEST_CASE("registers: rows of a read-only table are read-only; widths, counts and ranges are checked") {

@@ -198,6 +198,23 @@ TEST_CASE("each key of a point is checked where it is written") {
         CHECK_REPORTS(one_point("table: discrete_inputs, address: 0, writable: true"), p + "writable", 11, 69,
                       "table: coils");
     }
+    SUBCASE("invert: bool points; format: hex: integer points shown as a text, read-only") {
+        CHECK_REPORTS(one_point("table: input, address: 0, invert: true"), p + "invert", 11, 57,
+                      "invert applies only to bool points");
+        CHECK(diagnostics_of(one_point("table: input, address: 0, bit: 3, invert: true")).empty());
+        CHECK(diagnostics_of(one_point("table: coils, address: 0, invert: true, writable: true")).empty());
+        CHECK_REPORTS(one_point("table: input, address: 0, type: float32, format: hex"), p + "format", 11, 72,
+                      "format: hex applies only to integer points");
+        CHECK_REPORTS(one_point("table: input, address: 0, format: octal"), p + "format", 11, 57, "number, hex");
+        CHECK_REPORTS(one_point("table: input, address: 0, format: hex, scale: 2"), p + "scale", 11, 69,
+                      "shows its registers as a text");
+        CHECK_REPORTS(one_point("table: holding, address: 0, format: hex, writable: true"), p + "writable", 11, 74,
+                      "is read-only");
+        CHECK_REPORTS(one_point("table: input, address: 0, format: hex, enum: {0: a}"), p + "enum", 11, 68,
+                      "not a label");
+        CHECK(diagnostics_of(one_point("table: input, address: 0, type: uint32, format: hex")).empty());
+        CHECK(diagnostics_of(one_point("table: input, address: 0, format: number, scale: 2")).empty());
+    }
     SUBCASE("period in range") {
         CHECK_REPORTS(one_point("table: input, address: 0, period: 2h"), p + "period", 11, 57, "out of range");
     }
@@ -259,6 +276,13 @@ TEST_CASE("alarms name a point they can be evaluated on") {
     CHECK_REPORTS(with_alarm("{name: x, point: t, above: 1, severity: fatal}"), a + "severity", 16, 53, "critical");
     CHECK_REPORTS(with_alarm("{name: X, point: t, above: 1}"), a + "name", 16, 20, "snake_case");
     CHECK_REPORTS(with_alarm("{point: t, above: 1}"), a + "name", 16, 13, "required key");
+    CHECK_REPORTS(with_alarm("{name: x, point: t, above: 1, text: 'hot {valu}'}"), a + "text", 16, 49,
+                  "a brace that is not {value}");
+    CHECK_REPORTS(with_alarm("{name: x, point: t, above: 1, text: 'hot }'}"), a + "text", 16, 49,
+                  "a brace that is not {value}");
+    CHECK(diagnostics_of(with_alarm("{name: x, point: t, above: 1, text: 'hot: {value} (max 1)'}")).empty());
+    CHECK_REPORTS(with_alarm("{name: x, point: t, above: 1, source: ''}"), a + "source", 16, 51, "one line");
+    CHECK(diagnostics_of(with_alarm("{name: x, point: t, above: 1, source: terminal X3}")).empty());
     CHECK(diagnostics_of(with_alarm("{name: x, point: m, not_equals: off}")).empty());
     CHECK(diagnostics_of(with_alarm("{name: x, point: on, equals: 1}")).empty());
     CHECK_REPORTS(device_with(R"(        points: [{name: t, table: input, address: 0}]

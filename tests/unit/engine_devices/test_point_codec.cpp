@@ -256,6 +256,47 @@ TEST_CASE("codec: bit points, coils and bool registers") {
     CHECK(encoded(whole, true) == Regs{1});
 }
 
+TEST_CASE("codec: invert makes a bool true while its bit (coil, register) is 0, both ways") {
+    fc::PointDef busy = point(PointType::boolean);
+    busy.bit = 0;
+    busy.invert = true;
+    CHECK(std::get<bool>(pts::decode(busy, Regs{0x0000})));
+    CHECK_FALSE(std::get<bool>(pts::decode(busy, Regs{0x0001})));
+    CHECK(std::get<bool>(pts::decode(busy, Regs{0x0002})));  // only bit 0 counts
+    CHECK(pts::raw_integer(busy, Regs{0x0000}) == 1);
+    CHECK(encoded(busy, true) == Regs{0x0000});
+    CHECK(encoded(busy, false) == Regs{0x0001});
+    busy.bit = 12;
+    CHECK(encoded(busy, false) == Regs{0x1000});
+
+    fc::PointDef coil = point(PointType::boolean);
+    coil.table = fc::RegisterTable::coils;
+    coil.invert = true;
+    CHECK(std::get<bool>(pts::decode(coil, Regs{0})));
+    CHECK_FALSE(std::get<bool>(pts::decode(coil, Regs{1})));
+    CHECK(encoded(coil, true) == Regs{0});
+    CHECK(encoded(coil, false) == Regs{1});
+}
+
+TEST_CASE("codec: format hex shows the registers in the point's orders, four digits a register") {
+    fc::PointDef v = point(PointType::uint32);
+    v.format = fc::PointFormat::hex;
+    CHECK(std::get<std::string>(pts::decode(v, Regs{0x0000, 0x0078})) == "0x00000078");
+    CHECK(std::get<std::string>(pts::decode(v, Regs{0xDEAD, 0xBEEF})) == "0xDEADBEEF");
+    v.word_order = WordOrder::low_first;
+    CHECK(std::get<std::string>(pts::decode(v, Regs{0xBEEF, 0xDEAD})) == "0xDEADBEEF");
+    v.byte_order = ByteOrder::little;
+    CHECK(std::get<std::string>(pts::decode(v, Regs{0xEFBE, 0xADDE})) == "0xDEADBEEF");
+    CHECK(pts::raw_integer(v, Regs{0xEFBE, 0xADDE}) == 0xDEADBEEF);
+
+    fc::PointDef s16 = point(PointType::int16);
+    s16.format = fc::PointFormat::hex;
+    CHECK(std::get<std::string>(pts::decode(s16, Regs{0xFFFE})) == "0xFFFE");  // the bits, not -2
+    fc::PointDef u64 = point(PointType::uint64);
+    u64.format = fc::PointFormat::hex;
+    CHECK(std::get<std::string>(pts::decode(u64, Regs{0x0123, 0x4567, 0x89AB, 0xCDEF})) == "0x0123456789ABCDEF");
+}
+
 TEST_CASE("codec: strings, two ASCII characters a register, NULs trimmed") {
     fc::PointDef s = point(PointType::string);
     s.count = 3;

@@ -136,7 +136,10 @@ core::PointModel generic_points() {
     label.count = 2;
     auto level = point_def("level", RegisterTable::holding, 40, PointType::uint16);
     auto offset_value = point_def("offset_value", RegisterTable::holding, 41, PointType::int32);
-    model.points = {temperature, mode, setpoint, counter, total, ratio, running, alarm_bit, label, level, offset_value};
+    auto version = point_def("version", RegisterTable::input, 50, PointType::uint32);
+    version.format = core::PointFormat::hex;  // a text, "0x...": a String metric
+    model.points = {temperature, mode,  setpoint, counter,      total,  ratio,
+                    running,     alarm_bit, label, level, offset_value, version};
     return model;
 }
 
@@ -166,7 +169,8 @@ TEST_CASE("sparkplug catalogue: a generic device's JSON fields are its metrics, 
                      {"temperature", T::float64}, {"mode", T::string}, {"mode_code", T::uint16},
                      {"setpoint", T::float32}, {"counter", T::uint32}, {"total", T::int64},
                      {"ratio", T::float64}, {"running", T::boolean}, {"alarm_bit", T::boolean},
-                     {"label", T::string}, {"level", T::uint16}, {"offset_value", T::int32}});
+                     {"label", T::string}, {"level", T::uint16}, {"offset_value", T::int32},
+                     {"version", T::string}});
     // Aliases from the first one given, in order; unique.
     for (std::size_t i = 0; i < metrics.size(); ++i) CHECK(metrics[i].alias == 5 + i);
 
