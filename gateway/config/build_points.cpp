@@ -26,6 +26,8 @@ namespace {
     for (const auto& [value, label] : raw.labels.entries) {
         point.labels.push_back(core::EnumLabel{*value, *label});
     }
+    point.enum_other = raw.enum_other.value_or("");
+    point.enum_code = raw.enum_code.value_or(true);
     point.writable = raw.writable.value_or(false);
     point.min = raw.min.value;
     point.max = raw.max.value;

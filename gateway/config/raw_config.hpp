@@ -137,6 +137,8 @@ struct RawPoint : RawNode {
     Field<double> offset;
     Field<std::string> unit;
     RawEnum labels;
+    Field<std::string> enum_other;
+    Field<bool> enum_code;
     Field<bool> writable;
     Field<double> min;
     Field<double> max;

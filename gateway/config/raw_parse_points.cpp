@@ -35,7 +35,8 @@ RawEnum parse_enum(const NodeRef& ref, DiagnosticSink& sink) {
 RawPoint parse_point(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "table", "address", "type", "bit", "count", "word_order", "byte_order", "scale",
-                         "offset", "unit", "enum", "writable", "min", "max", "period", "deadband", "invert", "format"},
+                         "offset", "unit", "enum", "enum_other", "enum_code", "writable", "min", "max", "period", "deadband",
+                         "invert", "format"},
                         sink);
     RawPoint raw;
     map.fill(raw);
@@ -51,6 +52,8 @@ RawPoint parse_point(const NodeRef& ref, DiagnosticSink& sink) {
     raw.offset = read_number(map, "offset");
     raw.unit = read_string(map, "unit");
     raw.labels = parse_enum(map.child("enum"), sink);
+    raw.enum_other = read_string(map, "enum_other");
+    raw.enum_code = read_bool(map, "enum_code");
     raw.writable = read_bool(map, "writable");
     raw.min = read_number(map, "min");
     raw.max = read_number(map, "max");

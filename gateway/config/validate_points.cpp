@@ -34,8 +34,28 @@ void refuse_for_type(DiagnosticSink& sink, const Field<T>& field, std::string_vi
 }
 
 void check_labels(const RawPoint& point, PointType type, DiagnosticSink& sink) {
-    if (point.labels.absent() || !point.labels.ok()) {
+    if (point.labels.absent()) {
+        if (point.enum_code.has_value()) {
+            sink.error(point.enum_code, "enum_code applies only to a point with enum; remove it");
+        }
+        if (point.enum_other.has_value()) {
+            sink.error(point.enum_other, "enum_other applies only to a point with enum; remove it");
+        }
         return;
+    }
+    if (!point.labels.ok()) {
+        return;
+    }
+    if (point.enum_other.has_value() && point.enum_other->empty()) {
+        sink.error(point.enum_other, "the label is empty; expected a text such as 'unknown' (or remove enum_other: "
+                                     "the code then stands for itself)");
+    }
+    // Writes name values by label: a writable point needs one value per label. A
+    // read-only one may show several codes alike (two spellings of one state).
+    const bool writable = point.writable.value_or(false);
+    if (writable && point.enum_code.has_value() && !*point.enum_code) {
+        sink.error(point.enum_code, "a writable enum point keeps its <name>_code (Sparkplug B writes the code); "
+                                    "remove enum_code: false or writable");
     }
     if (!is_integer(type) && type != PointType::boolean) {
         sink.error(point.labels, "enum applies only to integer and bool points (this point is " + type_text(type) +
@@ -55,10 +75,11 @@ void check_labels(const RawPoint& point, PointType type, DiagnosticSink& sink) {
             if (value.has_value() && other_value.has_value() && *value == *other_value) {
                 sink.error(value, "the raw value " + std::to_string(*value) + " is already labelled '" +
                                       other_label.value_or("") + "'; expected one label per value");
-            } else if (label.has_value() && other_label.has_value() && *label == *other_label) {
+            } else if (writable && label.has_value() && other_label.has_value() && *label == *other_label) {
                 sink.error(label, "the label '" + *label + "' is already used for " +
                                       std::to_string(other_value.value_or(0)) +
-                                      "; expected one value per label (writes name values by label)");
+                                      "; expected one value per label on a writable point (writes name values "
+                                      "by label)");
             }
         }
     }
@@ -94,11 +115,9 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
         sink.error(point.type, "table " + std::string(core::to_string(*point.table)) +
                                    " holds single bits; expected type: bool (or remove type)");
         shape_ok = false;
-    } else if (point.table.has_value() && !bits && type == PointType::boolean) {
-        sink.error(point.type, "a bool point of table " + std::string(core::to_string(*point.table)) +
-                                   " needs bit: 0..15 (the bit of the register), or a coils / discrete_inputs table");
-        shape_ok = false;
     }
+    // A bool of a holding / input register without bit: is the whole register, true
+    // while it is not 0 (a flag register that reads 0 / 1).
     if (type == PointType::string && !bits) {
         if (require(sink, point.count, "the number of registers of the string (two characters each), 1..125")) {
             shape_ok = check_range(sink, point.count, Range<std::int64_t>{1, RegisterBlock::max_registers}) && shape_ok;

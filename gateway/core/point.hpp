@@ -114,6 +114,8 @@ struct PointDef {
     double offset = 0.0;
     std::string unit;
     std::vector<EnumLabel> labels;  ///< `enum:`; empty when none
+    std::string enum_other;         ///< the label of a code `enum:` does not name; empty: the code itself
+    bool enum_code = true;          ///< an enum point also gives `<name>_code`
     bool writable = false;
     std::optional<double> min;  ///< writes, engineering units
     std::optional<double> max;

@@ -41,6 +41,7 @@ using core::AlarmCondition;
     PointValue value = decode(point, registers);
     if (const auto* code = std::get_if<std::int64_t>(&value); code != nullptr && !point.labels.empty()) {
         if (const std::string_view label = label_of(point, *code); !label.empty()) return std::string{label};
+        if (!point.enum_other.empty()) return point.enum_other;
     }
     if (auto* text = std::get_if<std::string>(&value)) return std::move(*text);
     return to_text(value);

@@ -66,10 +66,15 @@ DecodedState PointState::decode(const RegisterImage& image) const {
         if (!p.labels.empty()) {
             if (const auto* code = std::get_if<std::int64_t>(&value)) {
                 const std::string_view label = points::label_of(p, *code);
-                // A code the enum does not name: the code stands in for the label.
-                state.fields.push_back(label.empty() ? Field{p.name, *code, p.unit}
-                                                     : Field{p.name, std::string{label}, p.unit});
-                state.fields.push_back(Field{p.name + "_code", *code, ""});
+                // A code the enum does not name: `enum_other`, else the code stands in.
+                if (!label.empty()) {
+                    state.fields.push_back(Field{p.name, std::string{label}, p.unit});
+                } else if (!p.enum_other.empty()) {
+                    state.fields.push_back(Field{p.name, p.enum_other, p.unit});
+                } else {
+                    state.fields.push_back(Field{p.name, *code, p.unit});
+                }
+                if (p.enum_code) state.fields.push_back(Field{p.name + "_code", *code, ""});
                 continue;
             }
         }

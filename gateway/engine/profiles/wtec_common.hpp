@@ -99,7 +99,8 @@ namespace fieldbridge::engine {
 /// Rule 5: moving (grip state 0) or homing (init state 9).
 [[nodiscard]] bool wtec_in_motion(const RegisterImage& image);
 
-/// Fields of the uniform registers present in the image.
+/// Fields of the uniform registers present in the image (the ASCII view's; the RTU
+/// mode's are the points of config/devices/wtec-rtu.yaml).
 void decode_wtec_uniform(const RegisterImage& image, DecodedState& state);
 
 /// Init failed (2; "beyond_limit" when @p raw_homing_code is the ASCII code 03) and

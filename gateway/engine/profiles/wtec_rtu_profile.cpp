@@ -22,7 +22,8 @@ IdentificationRead wtec_rtu_identification() noexcept { return IdentificationRea
 
 WtecRtuProfile::WtecRtuProfile(const ProfileOptions& options)
     : ModbusProfile(builtin_register_map(DeviceType::wtec_rtu, options), wtec_rtu_wire_functions(), options,
-                    WordOrder::high_first) {}
+                    WordOrder::high_first),
+      state_(builtin_state_points(DeviceType::wtec_rtu, options)) {}
 
 std::vector<PollUnit> WtecRtuProfile::poll_units() const {
     using namespace wtec_reg;
@@ -44,20 +45,11 @@ bool WtecRtuProfile::in_motion(const RegisterImage& image) const {
 }
 
 DecodedState WtecRtuProfile::decode_state(const RegisterImage& image) const {
-    DecodedState state;
-    decode_wtec_uniform(image, state);
-    if (const auto v = image.value(Table::holding, wtec_reg::save)) {
-        // Table 2.10: 1 = new data was saved and loaded at power-up.
-        state.fields.push_back({"saved", *v == 1, ""});
-    }
-    if (const auto v = image.value(Table::holding, wtec_reg::device_id)) {
-        state.fields.push_back({"device_id", std::int64_t{*v}, ""});
-    }
-    return state;
+    return state_.decode(image);
 }
 
 std::vector<Alarm> WtecRtuProfile::alarms(const RegisterImage& image) const {
-    return wtec_uniform_alarms(image, std::nullopt);
+    return state_.alarms(image);
 }
 
 OperationSet WtecRtuProfile::operations() const { return wtec_operations(); }

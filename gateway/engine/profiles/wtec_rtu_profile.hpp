@@ -7,8 +7,11 @@
 /// §2.1.1); a client's FC16 goes out as one FC06 per register, in order, so a
 /// PLC program written for the ASCII view (which takes FC16) works unchanged.
 /// 0x0201, 0x0203 and 0x0301 are holes: status is polled as three reads.
+/// State fields and alarms: the points and alarms of its definition
+/// (config/devices/wtec-rtu.yaml).
 
 #include "engine/profiles/modbus_profile.hpp"
+#include "engine/profiles/point_state.hpp"
 
 namespace fieldbridge::engine {
 
@@ -28,6 +31,8 @@ public:
 
 private:
     [[nodiscard]] std::vector<PollUnit> poll_units() const override;
+
+    PointState state_;
 };
 
 }  // namespace fieldbridge::engine

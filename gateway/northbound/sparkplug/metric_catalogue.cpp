@@ -116,10 +116,11 @@ bool MetricCatalogue::add_device(const DeviceShape& shape) {
             if (point.deadband) device.deadband[point.name] = *point.deadband;
             if (!point.labels.empty()) {
                 // An enum point is two fields of the JSON state: the label under the
-                // point's name and the code under <name>_code (generic_profile.cpp).
+                // point's name and the code under <name>_code (engine/profiles/point_state.cpp).
                 add_metric(device, shape.name,
                            CatalogueMetric{point.name, point.name, std::nullopt, 0, DataType::string, point.unit,
                                            false, &point});
+                if (!point.enum_code) continue;  // enum_code: false, the label alone
                 const std::string code = point.name + "_code";
                 add_metric(device, shape.name,
                            CatalogueMetric{code, code, std::nullopt, 0, integer_datatype(point.type), "",

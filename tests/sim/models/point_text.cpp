@@ -113,9 +113,10 @@ PointRegisters registers_of_text(const core::PointDef& point, std::string_view t
     if (point.type == PointType::boolean) {
         const auto value = parse_bool(text);
         if (!value) return {{}, "'" + std::string(text) + "' is not a bool; use true or false"};
-        if (!point.bit) return {{static_cast<std::uint16_t>(*value)}, {}};
+        const bool set = *value != point.invert;  // an inverted point reads true while its bit is 0
+        if (!point.bit) return {{static_cast<std::uint16_t>(set)}, {}};
         const auto mask = static_cast<std::uint16_t>(1u << *point.bit);
-        return {{static_cast<std::uint16_t>(*value ? current | mask : current & ~mask)}, {}};
+        return {{static_cast<std::uint16_t>(set ? current | mask : current & ~mask)}, {}};
     }
     return numeric(point, text);
 }

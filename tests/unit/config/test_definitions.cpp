@@ -498,6 +498,24 @@ TEST_CASE("excd203mb's state is points of its definition: the fields and the ala
     CHECK(alarm.source == "holding 0x02D6");
 }
 
+TEST_CASE("wtec-rtu's state is points of its definition: the fields and the alarms of docs/mqtt.md") {
+    const DeviceDefinition* wtec = builtin_definition(DeviceType::wtec_rtu);
+    REQUIRE(wtec != nullptr);
+    std::vector<std::string> names;
+    for (const auto& point : wtec->points.points) names.push_back(point.name);
+    CHECK(names == std::vector<std::string>{"init_state", "grip_state", "position_pct", "target_pct", "force_pct",
+                                            "speed_pct", "estop", "init_direction", "saved", "device_id"});
+    const auto& grip = wtec->points.points.at(1);
+    CHECK(grip.enum_other == "unknown");
+    CHECK(grip.labels.size() == 5);  // 11 and 0x11 are both motor_released
+    CHECK_FALSE(wtec->points.points.at(7).enum_code);
+    REQUIRE(wtec->points.alarms.size() == 2);
+    CHECK(wtec->points.alarms.at(0).name == "init_failed");
+    CHECK(wtec->points.alarms.at(0).threshold == 2);
+    CHECK(wtec->points.alarms.at(1).name == "emergency_stop");
+    CHECK(wtec->points.alarms.at(1).severity == fieldbridge::core::AlarmSeverity::critical);
+}
+
 TEST_CASE("an operator's copy with points: replaces the compiled-in state; one without keeps it") {
     const fieldbridge::test::TempDir dir("fb-definitions");
     const auto copy = dir.path() / "devices" / "excd203mb.yaml";

@@ -155,7 +155,7 @@ TEST_CASE("each key of a point is checked where it is written") {
     }
     SUBCASE("table and type fit") {
         CHECK_REPORTS(one_point("table: coils, address: 0, type: uint16"), p + "type", 11, 55, "holds single bits");
-        CHECK_REPORTS(one_point("table: holding, address: 0, type: bool"), p + "type", 11, 57, "needs bit: 0..15");
+        CHECK(diagnostics_of(one_point("table: holding, address: 0, type: bool")).empty());  // the whole register
         CHECK_REPORTS(one_point("table: holding, address: 0, bit: 16"), p + "bit", 11, 56, "out of range", "0..15");
         CHECK_REPORTS(one_point("table: coils, address: 0, bit: 1"), p + "bit", 11, 54, "bit applies to holding and input");
         CHECK_REPORTS(one_point("table: input, address: 0, type: int32, bit: 1"), p + "type", 11, 55,
@@ -188,8 +188,10 @@ TEST_CASE("each key of a point is checked where it is written") {
         CHECK_REPORTS(one_point("table: input, address: 0, enum: {x: a}"), p + "enum.x", 11, 56, "not an integer");
         CHECK_REPORTS(one_point("table: input, address: 0, enum: {0: a, 0x0: b}"), p + "enum.0x0", 11, 62,
                       "already labelled 'a'");
-        CHECK_REPORTS(one_point("table: input, address: 0, enum: {0: a, 1: a}"), p + "enum.1", 11, 65,
-                      "already used for 0");
+        CHECK_REPORTS(one_point("table: holding, address: 0, writable: true, enum: {0: a, 1: a}"), p + "enum.1", 11, 83,
+                      "already used for 0", "writable point");
+        // Read-only: two codes may read alike (two spellings of one state).
+        CHECK(diagnostics_of(one_point("table: input, address: 0, enum: {0: a, 1: a}")).empty());
         CHECK_REPORTS(one_point("table: input, address: 0, scale: abc"), p + "scale", 11, 56, "number");
     }
     SUBCASE("writable: coils and holding only") {
@@ -197,6 +199,16 @@ TEST_CASE("each key of a point is checked where it is written") {
                       "table: holding");
         CHECK_REPORTS(one_point("table: discrete_inputs, address: 0, writable: true"), p + "writable", 11, 69,
                       "table: coils");
+    }
+    SUBCASE("enum_other and enum_code: with an enum only") {
+        CHECK_REPORTS(one_point("table: input, address: 0, enum_other: x"), p + "enum_other", 11, 61,
+                      "only to a point with enum");
+        CHECK_REPORTS(one_point("table: input, address: 0, enum_code: false"), p + "enum_code", 11, 60,
+                      "only to a point with enum");
+        CHECK_REPORTS(one_point("table: input, address: 0, enum: {0: a}, enum_other: ''"), p + "enum_other", 11, 75,
+                      "the label is empty");
+        CHECK(diagnostics_of(one_point("table: input, address: 0, enum: {0: a}, enum_other: b, enum_code: false"))
+                  .empty());
     }
     SUBCASE("invert: bool points; format: hex: integer points shown as a text, read-only") {
         CHECK_REPORTS(one_point("table: input, address: 0, invert: true"), p + "invert", 11, 57,

@@ -240,6 +240,40 @@ TEST_CASE("generic points: fields in engineering units, in the points' order") {
     CHECK(field<std::int64_t>(g.decode_state(image), "mode") == 9);
 }
 
+TEST_CASE("generic points: enum_other names unknown codes, enum_code: false drops <name>_code, invert, hex") {
+    fe::ProfileOptions o;
+    fc::PointDef direction = point_def("direction", Table::holding, 0x0000, fc::PointType::uint16);
+    direction.labels = {{1, "open"}, {2, "close"}, {0x11, "close"}};  // read-only: two codes alike
+    direction.enum_other = "unknown";
+    direction.enum_code = false;
+    o.points.points.push_back(direction);
+    fc::PointDef busy = point_def("busy", Table::holding, 0x0001, fc::PointType::boolean);
+    busy.bit = 0;
+    busy.invert = true;
+    o.points.points.push_back(busy);
+    fc::PointDef flag = point_def("flag", Table::holding, 0x0002, fc::PointType::boolean);  // the whole register
+    o.points.points.push_back(flag);
+    fc::PointDef version = point_def("version", Table::holding, 0x0003, fc::PointType::uint32);
+    version.format = fc::PointFormat::hex;
+    o.points.points.push_back(version);
+    const fe::GenericProfile g{o};
+    fe::RegisterImage image;
+    feed(g, image, read_holding(0x0000, 5), {0x11, 0, 2, 0x0001, 0x0203});
+    fe::DecodedState s = g.decode_state(image);
+    std::vector<std::string> names;
+    for (const fe::Field& f : s.fields) names.push_back(f.name);
+    CHECK(names == std::vector<std::string>{"direction", "busy", "flag", "version"});
+    CHECK(field<std::string>(s, "direction") == "close");
+    CHECK(field<bool>(s, "busy"));
+    CHECK(field<bool>(s, "flag"));
+    CHECK(field<std::string>(s, "version") == "0x00010203");
+    feed(g, image, read_holding(0x0000, 3), {7, 1, 0});
+    s = g.decode_state(image);
+    CHECK(field<std::string>(s, "direction") == "unknown");
+    CHECK_FALSE(field<bool>(s, "busy"));
+    CHECK_FALSE(field<bool>(s, "flag"));
+}
+
 TEST_CASE("generic points: alarms with hysteresis, bit and enum conditions") {
     fe::ProfileOptions o = thermo_options();
     fc::AlarmRule hot;

@@ -165,6 +165,18 @@ TEST_CASE("point text: every integer and float type, both word and byte orders")
     CHECK_FALSE(registers_of_text(p, "inf").error.empty());
 }
 
+TEST_CASE("point text: an inverted bool sets the opposite bit; a whole-register bool 1 or 0") {
+    auto busy = point("busy", RegisterTable::holding, 0, PointType::boolean);
+    busy.bit = 0;
+    busy.invert = true;
+    CHECK(registers_of_text(busy, "true", 0x0003).registers == std::vector<std::uint16_t>{0x0002});
+    CHECK(registers_of_text(busy, "false", 0x0002).registers == std::vector<std::uint16_t>{0x0003});
+    auto flag = point("flag", RegisterTable::holding, 1, PointType::boolean);
+    CHECK(registers_of_text(flag, "true").registers == std::vector<std::uint16_t>{1});
+    flag.invert = true;
+    CHECK(registers_of_text(flag, "true").registers == std::vector<std::uint16_t>{0});
+}
+
 TEST_CASE("definition device: addresses outside 1-247 are refused") {
     DeviceOptions options;
     options.definition = thermostat();
