@@ -140,24 +140,32 @@ private:
     std::thread thread_;
 };
 
+/// A client named @p name whose CONNECT @p broker has read (and holds the answer to);
+/// each connected / connect_failed event counts in @p events.
+std::unique_ptr<fm::PahoClient> connecting_client(asio::io_context& io, HeldBroker& broker, const std::string& name,
+                                                  std::atomic<int>& events) {
+    fm::PahoOptions o;
+    o.uri = broker.uri();
+    o.client_id = "fieldbridge-test-" + name;
+    o.keep_alive = 1s;
+    o.will = fm::Message{name + "-test/status", "offline", 1, true};
+    auto client = std::make_unique<fm::PahoClient>(io, o);
+    fm::ClientEvents e;
+    e.connected = [&events] { ++events; };
+    e.connect_failed = [&events](const std::string&) { ++events; };
+    client->set_events(std::move(e));
+    client->connect();
+    REQUIRE(broker.wait_connect(5s));
+    return client;
+}
+
 }  // namespace
 
 TEST_CASE("paho client: left to the process exit with a connect in flight, the late CONNACK reaches a live listener") {
     HeldBroker broker;
     asio::io_context io;
-    fm::PahoOptions o;
-    o.uri = broker.uri();
-    o.client_id = "fieldbridge-test-exit";
-    o.keep_alive = 1s;
-    o.will = fm::Message{"exit-test/status", "offline", 1, true};
-    auto client = std::make_unique<fm::PahoClient>(io, o);
     std::atomic<int> events{0};
-    fm::ClientEvents e;
-    e.connected = [&] { ++events; };
-    e.connect_failed = [&](const std::string&) { ++events; };
-    client->set_events(std::move(e));
-    client->connect();
-    REQUIRE(broker.wait_connect(5s));
+    auto client = connecting_client(io, broker, "exit", events);
 
     client->leave_to_process_exit();
     client.reset();
@@ -173,19 +181,8 @@ TEST_CASE("paho client: left to the process exit with a connect in flight, the l
 TEST_CASE("paho client: destroyed with a connect in flight, the late CONNACK reaches nothing") {
     HeldBroker broker;
     asio::io_context io;
-    fm::PahoOptions o;
-    o.uri = broker.uri();
-    o.client_id = "fieldbridge-test-destroyed";
-    o.keep_alive = 1s;
-    o.will = fm::Message{"destroyed-test/status", "offline", 1, true};
-    auto client = std::make_unique<fm::PahoClient>(io, o);
     std::atomic<int> events{0};
-    fm::ClientEvents e;
-    e.connected = [&] { ++events; };
-    e.connect_failed = [&](const std::string&) { ++events; };
-    client->set_events(std::move(e));
-    client->connect();
-    REQUIRE(broker.wait_connect(5s));
+    auto client = connecting_client(io, broker, "destroyed", events);
     client.reset();
     broker.answer();
     CHECK_FALSE(broker.wait_ping(2s));
