@@ -15,6 +15,7 @@
 #include <string>
 
 #include "engine/tcp_stream_port.hpp"
+#include "free_port.hpp"
 
 namespace {
 
@@ -23,15 +24,9 @@ namespace fe = fieldbridge::engine;
 /// A loopback listener on a free port; accept() takes one client.
 struct Listener {
     Listener() {
-        fd = ::socket(AF_INET, SOCK_STREAM, 0);
-        sockaddr_in address{};
-        address.sin_family = AF_INET;
-        address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        REQUIRE(::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
-        REQUIRE(::listen(fd, 1) == 0);
-        socklen_t length = sizeof address;
-        ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-        port = ntohs(address.sin_port);
+        const fieldbridge::test::LoopbackListener listening = fieldbridge::test::listen_on_loopback();
+        fd = listening.fd;
+        port = listening.port;
     }
     ~Listener() {
         if (client >= 0) ::close(client);

@@ -24,6 +24,7 @@
 
 #include <asio/io_context.hpp>
 
+#include "free_port.hpp"
 #include "northbound/mqtt/paho_client.hpp"
 
 namespace {
@@ -37,16 +38,9 @@ using namespace std::chrono_literals;
 class HeldBroker {
 public:
     HeldBroker() {
-        listener_ = ::socket(AF_INET, SOCK_STREAM, 0);
-        REQUIRE(listener_ >= 0);
-        sockaddr_in a{};
-        a.sin_family = AF_INET;
-        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        REQUIRE(::bind(listener_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
-        REQUIRE(::listen(listener_, 1) == 0);
-        socklen_t length = sizeof a;
-        REQUIRE(::getsockname(listener_, reinterpret_cast<sockaddr*>(&a), &length) == 0);
-        port_ = ntohs(a.sin_port);
+        const fieldbridge::test::LoopbackListener listening = fieldbridge::test::listen_on_loopback();
+        listener_ = listening.fd;
+        port_ = listening.port;
         thread_ = std::thread([this] { serve(); });
     }
     ~HeldBroker() {
