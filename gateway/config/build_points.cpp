@@ -35,6 +35,7 @@ namespace {
     point.deadband = raw.deadband.value;
     point.invert = raw.invert.value_or(false);
     point.format = raw.format.value_or(core::PointFormat::number);
+    point.format_text = raw.format_text.value_or("");
     return point;
 }
 

@@ -146,6 +146,7 @@ struct RawPoint : RawNode {
     Field<double> deadband;
     Field<bool> invert;
     Field<core::PointFormat> format;
+    Field<std::string> format_text;  ///< format `text`: the template, at the mark of format:
 };
 
 struct RawAlarm : RawNode {

@@ -32,6 +32,24 @@ RawEnum parse_enum(const NodeRef& ref, DiagnosticSink& sink) {
     return raw;
 }
 
+/// `format:` is number, hex, or a template of the registers ("V{0}.{1}"): any other
+/// text is a template, which check_point() requires to name a register.
+void read_format(const MapReader& map, RawPoint& raw) {
+    raw.format_text = read_string(map, "format");
+    raw.format.path = raw.format_text.path;
+    raw.format.mark = raw.format_text.mark;
+    raw.format.invalid = raw.format_text.invalid;
+    if (!raw.format_text.has_value()) return;
+    for (const auto& [name, value] : core::point_format_names) {
+        if (*raw.format_text == name) {
+            raw.format.value = value;
+            raw.format_text.value.reset();
+            return;
+        }
+    }
+    raw.format.value = core::PointFormat::text;
+}
+
 RawPoint parse_point(const NodeRef& ref, DiagnosticSink& sink) {
     const MapReader map(ref,
                         {"name", "table", "address", "type", "bit", "count", "word_order", "byte_order", "scale",
@@ -60,7 +78,7 @@ RawPoint parse_point(const NodeRef& ref, DiagnosticSink& sink) {
     raw.period = read_duration(map, "period");
     raw.deadband = read_number(map, "deadband");
     raw.invert = read_bool(map, "invert");
-    raw.format = read_enum(map, "format", core::point_format_names);
+    read_format(map, raw);
     return raw;
 }
 

@@ -140,6 +140,7 @@ struct PointSpan {
     bool shape_ok = false;  ///< table, address and width valid: the fields below are set
     RegisterTable table = RegisterTable::holding;
     bool bit = false;  ///< a `bit:` point
+    bool text = false;  ///< its format is a template: a text, not a number
     std::int64_t first = 0;
     std::int64_t last = 0;
 };

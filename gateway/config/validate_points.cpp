@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "config/validate.hpp"
+#include "core/text_template.hpp"
 
 namespace fieldbridge::config {
 
@@ -33,6 +34,69 @@ void refuse_for_type(DiagnosticSink& sink, const Field<T>& field, std::string_vi
     }
 }
 
+[[nodiscard]] bool is_text_format(const RawPoint& point) noexcept {
+    return point.format.has_value() && *point.format == core::PointFormat::text;
+}
+
+/// Registers (bits) the point spans, its shape being valid.
+[[nodiscard]] std::int64_t width_of(const RawPoint& point, PointType type) {
+    if (point.table.has_value() && core::is_bit_table(*point.table)) return 1;
+    const auto count = static_cast<std::uint16_t>(point.count.value_or(0));
+    return is_text_format(point) ? count : core::registers_of(type, count);
+}
+
+/// `enum_other:` may show the code as {value} or {value:hex}.
+void check_enum_other(const RawPoint& point, DiagnosticSink& sink) {
+    if (!point.enum_other.has_value()) return;
+    const auto error = core::template_error(
+        *point.enum_other, [](std::string_view name) { return name == core::PointDef::code_placeholder; });
+    if (error) {
+        sink.error(point.enum_other, *error + "; enum_other may show the code as {value} or {value:hex} (write "
+                                              "{{ and }} for braces)");
+    }
+}
+
+/// `format:` as a template ("V{0}.{1}.{2}.{3}"): `count` registers of int16 / uint16,
+/// each placeholder one of them, read-only and unscaled.
+void check_text_format(const RawPoint& point, PointType type, DiagnosticSink& sink) {
+    if (type != PointType::uint16 && type != PointType::int16) {
+        sink.error(point.format, "'" + *point.format_text + "' is neither number nor hex, so it is a template of "
+                                 "registers, which applies to uint16 and int16 points (this point is " +
+                                 type_text(type) + "); expected number, hex or type: uint16");
+        return;
+    }
+    const std::int64_t count = point.count.value_or(0);
+    std::optional<std::string> error = core::template_error(*point.format_text, [count](std::string_view name) {
+        std::int64_t index = 0;
+        for (const char c : name) {
+            if (c < '0' || c > '9' || index > 1000) return false;
+            index = index * 10 + (c - '0');
+        }
+        return index < count;
+    });
+    if (!error && !core::has_placeholder(*point.format_text)) {
+        error = "it names no register";
+    }
+    if (error) {
+        sink.error(point.format, "format '" + *point.format_text + "': " + *error +
+                                     "; expected number, hex, or a template of the point's count: registers, {0} "
+                                     "to {" + std::to_string(count > 0 ? count - 1 : 0) +
+                                     "} ({0:hex}: 0x and four digits)");
+    }
+    for (const auto* key : {&point.scale, &point.offset, &point.min, &point.max, &point.deadband}) {
+        if (key->has_value()) {
+            sink.error(*key, "a point with a format template shows its registers as a text; remove this key");
+        }
+    }
+    if (!point.labels.absent()) {
+        sink.error(point.labels, "a point with a format template shows its registers as a text, not a label; "
+                                 "remove enum (or the format)");
+    }
+    if (point.writable.value_or(false)) {
+        sink.error(point.writable, "a point with a format template is read-only; expected writable: false");
+    }
+}
+
 void check_labels(const RawPoint& point, PointType type, DiagnosticSink& sink) {
     if (point.labels.absent()) {
         if (point.enum_code.has_value()) {
@@ -50,6 +114,7 @@ void check_labels(const RawPoint& point, PointType type, DiagnosticSink& sink) {
         sink.error(point.enum_other, "the label is empty; expected a text such as 'unknown' (or remove enum_other: "
                                      "the code then stands for itself)");
     }
+    check_enum_other(point, sink);
     // Writes name values by label: a writable point needs one value per label. A
     // read-only one may show several codes alike (two spellings of one state).
     const bool writable = point.writable.value_or(false);
@@ -118,7 +183,13 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
     }
     // A bool of a holding / input register without bit: is the whole register, true
     // while it is not 0 (a flag register that reads 0 / 1).
-    if (type == PointType::string && !bits) {
+    if (is_text_format(point) && !bits && !point.bit.has_value() && core::has_placeholder(*point.format_text)) {
+        if (require(sink, point.count, "the number of registers the format template shows, 1..125")) {
+            shape_ok = check_range(sink, point.count, Range<std::int64_t>{1, RegisterBlock::max_registers}) && shape_ok;
+        } else {
+            shape_ok = false;
+        }
+    } else if (type == PointType::string && !bits) {
         if (require(sink, point.count, "the number of registers of the string (two characters each), 1..125")) {
             shape_ok = check_range(sink, point.count, Range<std::int64_t>{1, RegisterBlock::max_registers}) && shape_ok;
         } else {
@@ -129,8 +200,7 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
                                     std::to_string(core::registers_of(type)) + " register(s); remove it");
     }
     if (shape_ok) {
-        const std::int64_t width =
-            bits ? 1 : core::registers_of(type, static_cast<std::uint16_t>(point.count.value_or(0)));
+        const std::int64_t width = width_of(point, type);
         if (*point.address + width - 1 > 0xFFFF) {
             sink.error(point.address, "the point " + hex16(*point.address) + " + " + std::to_string(width) +
                                           " registers runs past 0xFFFF; expected address + width - 1 <= 0xFFFF");
@@ -151,6 +221,14 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
     if (point.invert.has_value() && type != PointType::boolean) {
         sink.error(point.invert, "invert applies only to bool points (this point is " + type_text(type) +
                                      "); remove it");
+    }
+    if (is_text_format(point)) {
+        if (bits || point.bit.has_value()) {
+            sink.error(point.format, "a format template shows registers; a bit is a bool (expected number, or "
+                                     "remove format)");
+        } else {
+            check_text_format(point, type, sink);
+        }
     }
     if (point.format.has_value() && *point.format == core::PointFormat::hex) {
         if (!is_integer(type)) {
@@ -288,16 +366,13 @@ std::vector<PointSpan> check_points(const RawSeq<RawPoint>& points, std::vector<
         span.line = point.mark.line;
         span.raw = &point;
         span.type = effective_type(point);
+        span.text = is_text_format(point);
         span.shape_ok = shape_ok;
         if (shape_ok) {
             span.table = *point.table;
             span.bit = point.bit.has_value();
             span.first = *point.address;
-            span.last = span.first + (core::is_bit_table(span.table)
-                                          ? 0
-                                          : core::registers_of(span.type,
-                                                               static_cast<std::uint16_t>(point.count.value_or(0))) -
-                                                1);
+            span.last = span.first + width_of(point, span.type) - 1;
         }
         const auto same_name =
             std::find_if(earlier.begin(), earlier.end(), [&](const PointSpan& s) { return s.name == span.name; });
@@ -370,7 +445,13 @@ std::vector<std::string> check_alarms(const RawSeq<RawAlarm>& alarms, const std:
             continue;
         }
         const PointType type = found->type;
-        const std::string of_point = " (point '" + found->name + "' is " + type_text(type) + ")";
+        const std::string of_point =
+            " (point '" + found->name + "' is " + (found->text ? "a text by its format template" : type_text(type)) + ")";
+        if (found->text) {
+            sink.error(alarm.point, "an alarm compares a number; the point '" + found->name +
+                                        "' shows its registers as a text (its format template)");
+            continue;
+        }
         for (const auto* field : {&alarm.above, &alarm.below}) {
             if (field->has_value() && !is_numeric(type)) {
                 sink.error(*field, "above / below compare numbers" + of_point + "; use equals or not_equals");
@@ -380,7 +461,7 @@ std::vector<std::string> check_alarms(const RawSeq<RawAlarm>& alarms, const std:
             if (!field->has_value()) {
                 continue;
             }
-            if (type == PointType::string) {
+            if (type == PointType::string || found->text) {
                 sink.error(*field, "equals / not_equals compare numbers or enum labels" + of_point);
             } else if (!alarm_value(*field, *found->raw)) {
                 sink.error(*field, "'" + **field + "' is neither a number nor a label of the point's enum" + of_point);

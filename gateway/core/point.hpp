@@ -82,8 +82,10 @@ struct Names<ByteOrder> {
 
 /// How an integer point's value is shown (`format:`): a number, or its registers as
 /// one hexadecimal text, "0x" and four upper-case digits per register ("0x00000078"
-/// for a uint32), for identifiers and versions that are codes rather than amounts.
-enum class PointFormat : std::uint8_t { number, hex };
+/// for a uint32), for identifiers and versions that are codes rather than amounts;
+/// or `text`: its `count` registers through a template (PointDef::format_text,
+/// core/text_template.hpp), written in files as the template itself ("V{0}.{1}").
+enum class PointFormat : std::uint8_t { number, hex, text };
 
 inline constexpr NameTable<PointFormat, 2> point_format_names{{
     {"number", PointFormat::number},
@@ -107,7 +109,7 @@ struct PointDef {
     std::uint16_t address = 0;
     PointType type = PointType::uint16;
     std::optional<std::uint8_t> bit;  ///< 0-15: a bool of one bit of a register
-    std::uint16_t count = 0;          ///< string: registers (two characters each)
+    std::uint16_t count = 0;          ///< string: registers (two characters each); format text: registers
     WordOrder word_order = WordOrder::high_first;
     ByteOrder byte_order = ByteOrder::big;
     double scale = 1.0;  ///< engineering value = raw × scale + offset
@@ -122,11 +124,16 @@ struct PointDef {
     std::chrono::milliseconds period{1000};
     std::optional<double> deadband;  ///< MQTT, engineering units
     bool invert = false;                        ///< bool points: true while the bit (coil) is 0
-    PointFormat format = PointFormat::number;  ///< integer points: `hex` shows a text
+    PointFormat format = PointFormat::number;  ///< integer points: `hex` and `text` show a text
+    std::string format_text;                   ///< `text`: the template; `{0}`... are its registers
+
+    /// The name by which `enum_other` shows the code it stands for: `{value}`, `{value:hex}`.
+    static constexpr std::string_view code_placeholder = "value";
 
     /// Registers (or bits) the point spans.
     [[nodiscard]] std::uint16_t width() const noexcept {
-        return is_bit_table(table) ? std::uint16_t{1} : registers_of(type, count);
+        if (is_bit_table(table)) return 1;
+        return format == PointFormat::text ? count : registers_of(type, count);
     }
     /// True when the point is one bit of a coil / discrete input or of a register.
     [[nodiscard]] bool is_bool() const noexcept { return type == PointType::boolean; }

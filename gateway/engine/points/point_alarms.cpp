@@ -40,8 +40,7 @@ using core::AlarmCondition;
 [[nodiscard]] std::string shown_text(const core::PointDef& point, std::span<const std::uint16_t> registers) {
     PointValue value = decode(point, registers);
     if (const auto* code = std::get_if<std::int64_t>(&value); code != nullptr && !point.labels.empty()) {
-        if (const std::string_view label = label_of(point, *code); !label.empty()) return std::string{label};
-        if (!point.enum_other.empty()) return point.enum_other;
+        if (std::string label = enum_text(point, *code); !label.empty()) return label;
     }
     if (auto* text = std::get_if<std::string>(&value)) return std::move(*text);
     return to_text(value);

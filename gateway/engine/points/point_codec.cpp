@@ -1,5 +1,7 @@
 #include "engine/points/point_codec.hpp"
 
+#include "core/text_template.hpp"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -117,7 +119,29 @@ struct RawInteger {
     return s;
 }
 
-[[nodiscard]] double engineering(const PointDef& p, double raw) noexcept { return raw * p.scale + p.offset; }
+/// raw × scale + offset; a scale of 1/n (0.1, 0.01) divides by n, so that 35 at 0.01
+/// is 0.35, the decimal an operator expects, not 0.35000000000000003.
+[[nodiscard]] double engineering(const PointDef& p, double raw) noexcept {
+    if (p.scale > 0.0 && p.scale < 1.0) {
+        const double divisor = std::round(1.0 / p.scale);
+        if (divisor * p.scale == 1.0) {
+            return raw / divisor + p.offset;
+        }
+    }
+    return raw * p.scale + p.offset;
+}
+
+/// A format template's text: each `{i}` the register i (as int16 or uint16), `{i:hex}`
+/// as "0x" and four upper-case digits.
+[[nodiscard]] std::string template_text(const PointDef& p, std::span<const std::uint16_t> registers) {
+    return core::expand_template(p.format_text, [&](const core::TemplateSlot& slot) -> std::string {
+        std::size_t index = 0;
+        for (const char c : slot.name) index = index * 10 + static_cast<std::size_t>(c - '0');
+        const std::uint16_t r = index < registers.size() ? registers[index] : std::uint16_t{0};
+        if (slot.hex) return hex_text(r, 1);
+        return p.type == PointType::int16 ? std::to_string(static_cast<std::int16_t>(r)) : std::to_string(r);
+    });
+}
 
 /// The inclusive range of an integer type's raw value, as doubles; the upper bound of
 /// the 64-bit types is exclusive (2^63, 2^64: the nearest doubles above the maximum).
@@ -296,6 +320,9 @@ PointValue decode(const PointDef& point, std::span<const std::uint16_t> register
     if (point.type == PointType::string) {
         return decode_string(point, registers);
     }
+    if (point.format == core::PointFormat::text) {
+        return template_text(point, registers);
+    }
     const std::uint64_t bits = raw_bits(point, registers);
     if (point.format == core::PointFormat::hex) {
         return hex_text(bits, point.width());
@@ -384,6 +411,15 @@ std::string_view label_of(const PointDef& point, std::int64_t code) {
         }
     }
     return {};
+}
+
+std::string enum_text(const PointDef& point, std::int64_t code) {
+    if (const std::string_view label = label_of(point, code); !label.empty()) {
+        return std::string{label};
+    }
+    return core::expand_template(point.enum_other, [&](const core::TemplateSlot& slot) {
+        return slot.hex ? hex_text(static_cast<std::uint64_t>(code), point.width()) : std::to_string(code);
+    });
 }
 
 std::string to_text(const PointValue& value) {

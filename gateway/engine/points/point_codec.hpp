@@ -64,6 +64,11 @@ struct Encoded {
 /// The label of @p code in the point's enum ("" when none).
 [[nodiscard]] std::string_view label_of(const core::PointDef& point, std::int64_t code);
 
+/// What the state shows for code @p code of an enum point: its label, else
+/// `enum_other` with `{value}` / `{value:hex}` replaced by the code ("" when the point
+/// has neither: the code then stands for itself).
+[[nodiscard]] std::string enum_text(const core::PointDef& point, std::int64_t code);
+
 /// @p value as an operator reads it: true, -2, 21.5, "text" (quoted, not escaped).
 [[nodiscard]] std::string to_text(const PointValue& value);
 

@@ -65,12 +65,10 @@ DecodedState PointState::decode(const RegisterImage& image) const {
         points::PointValue value = points::decode(p, registers);
         if (!p.labels.empty()) {
             if (const auto* code = std::get_if<std::int64_t>(&value)) {
-                const std::string_view label = points::label_of(p, *code);
                 // A code the enum does not name: `enum_other`, else the code stands in.
+                std::string label = points::enum_text(p, *code);
                 if (!label.empty()) {
-                    state.fields.push_back(Field{p.name, std::string{label}, p.unit});
-                } else if (!p.enum_other.empty()) {
-                    state.fields.push_back(Field{p.name, p.enum_other, p.unit});
+                    state.fields.push_back(Field{p.name, std::move(label), p.unit});
                 } else {
                     state.fields.push_back(Field{p.name, *code, p.unit});
                 }

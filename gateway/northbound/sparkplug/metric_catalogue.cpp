@@ -82,7 +82,7 @@ DataType argument_datatype(const engine::FieldType& type) {
 }  // namespace
 
 DataType point_datatype(const core::PointDef& point) {
-    if (point.format == core::PointFormat::hex) return DataType::string;  // "0x00000078"
+    if (point.format != core::PointFormat::number) return DataType::string;  // "0x00000078", "V3.0.1.884"
     const DataType type = integer_datatype(point.type);
     const bool scaled = point.scale != 1.0 || point.offset != 0.0;
     if (scaled && is_integer(type)) return DataType::float64;

@@ -110,6 +110,10 @@ PointRegisters registers_of_text(const core::PointDef& point, std::string_view t
     if (point.type == PointType::string) {
         return string_value(point, text);
     }
+    if (point.format == core::PointFormat::text) {
+        return {{}, "the point shows its " + std::to_string(point.count) +
+                        " registers through a template; set them with set-register"};
+    }
     if (point.type == PointType::boolean) {
         const auto value = parse_bool(text);
         if (!value) return {{}, "'" + std::string(text) + "' is not a bool; use true or false"};

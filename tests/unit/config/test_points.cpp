@@ -227,6 +227,36 @@ TEST_CASE("each key of a point is checked where it is written") {
         CHECK(diagnostics_of(one_point("table: input, address: 0, type: uint32, format: hex")).empty());
         CHECK(diagnostics_of(one_point("table: input, address: 0, format: number, scale: 2")).empty());
     }
+    SUBCASE("format: a template of the point's registers") {
+        CHECK(diagnostics_of(one_point("table: input, address: 0, count: 4, format: 'V{0}.{1}.{2}.{3}'")).empty());
+        CHECK(diagnostics_of(one_point("table: input, address: 0, type: int16, count: 2, format: '{1:hex}/{0}'"))
+                  .empty());
+        CHECK_REPORTS(one_point("table: input, address: 0, format: 'V{0}'"), p + "count", 11, 13,
+                      "the number of registers the format template shows");
+        CHECK_REPORTS(one_point("table: input, address: 0, count: 2, format: 'V{0}.{2}'"), p + "format", 11, 67,
+                      "'{2}' is not a name it may use", "{0} to {1}");
+        CHECK_REPORTS(one_point("table: input, address: 0, count: 2, format: 'V{0'"), p + "format", 11, 67,
+                      "never closed");
+        CHECK_REPORTS(one_point("table: input, address: 0, count: 2, format: '{0:dec}'"), p + "format", 11, 67,
+                      "the only style is ':hex'");
+        CHECK_REPORTS(one_point("table: input, address: 0, type: uint32, count: 2, format: '{0}'"), p + "format", 11,
+                      81, "applies to uint16 and int16 points");
+        CHECK_REPORTS(one_point("table: input, address: 0, count: 2, format: '{0}', scale: 2"), p + "scale", 11, 81,
+                      "format template");
+        CHECK_REPORTS(one_point("table: holding, address: 0, count: 2, format: '{0}', writable: true"), p + "writable",
+                      11, 86, "read-only");
+        CHECK_REPORTS(one_point("table: input, address: 0xFFFF, count: 2, format: '{0}'"), p + "address", 11, 46,
+                      "runs past 0xFFFF");
+        CHECK_REPORTS(one_point("table: input, address: 0, bit: 1, format: '{0}'"), p + "format", 11, 65,
+                      "a bit is a bool");
+    }
+    SUBCASE("enum_other may show the code") {
+        CHECK(diagnostics_of(one_point("table: input, address: 0, enum: {0: a}, enum_other: 'unknown ({value:hex})'"))
+                  .empty());
+        CHECK(diagnostics_of(one_point("table: input, address: 0, enum: {0: a}, enum_other: 'code {value}'")).empty());
+        CHECK_REPORTS(one_point("table: input, address: 0, enum: {0: a}, enum_other: 'code {0}'"), p + "enum_other",
+                      11, 75, "'{0}' is not a name it may use", "{value} or {value:hex}");
+    }
     SUBCASE("period in range") {
         CHECK_REPORTS(one_point("table: input, address: 0, period: 2h"), p + "period", 11, 57, "out of range");
     }
@@ -297,6 +327,12 @@ TEST_CASE("alarms name a point they can be evaluated on") {
     CHECK(diagnostics_of(with_alarm("{name: x, point: t, above: 1, source: terminal X3}")).empty());
     CHECK(diagnostics_of(with_alarm("{name: x, point: m, not_equals: off}")).empty());
     CHECK(diagnostics_of(with_alarm("{name: x, point: on, equals: 1}")).empty());
+    // A point shown through a format template is a text: nothing to compare.
+    CHECK_REPORTS(device_with(R"(        points:
+          - {name: v, table: input, address: 4, count: 2, format: 'V{0}.{1}'}
+        alarms:
+          - {name: x, point: v, equals: 1}
+)"), a + "point", 13, 30, "shows its registers as a text");
     CHECK_REPORTS(device_with(R"(        points: [{name: t, table: input, address: 0}]
         alarms:
           - {name: x, point: t, above: 1}

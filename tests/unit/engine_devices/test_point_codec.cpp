@@ -297,6 +297,56 @@ TEST_CASE("codec: format hex shows the registers in the point's orders, four dig
     CHECK(std::get<std::string>(pts::decode(u64, Regs{0x0123, 0x4567, 0x89AB, 0xCDEF})) == "0x0123456789ABCDEF");
 }
 
+TEST_CASE("codec: a scale of 1/n gives the decimal an operator expects") {
+    // 35 × 0.01 is 0.35000000000000003 in binary floating point; 35 / 100 is 0.35.
+    for (const double scale : {0.1, 0.01, 0.001}) {
+        const fc::PointDef p = point(PointType::uint16, WordOrder::high_first, ByteOrder::big, scale, 0.0);
+        for (std::uint32_t raw = 0; raw <= 0xFFFF; ++raw) {
+            const double expected = static_cast<double>(raw) / std::round(1.0 / scale);
+            if (std::get<double>(pts::decode(p, Regs{static_cast<std::uint16_t>(raw)})) != expected) {
+                FAIL("scale " << scale << " raw " << raw);
+            }
+        }
+        // And a write of that decimal is the raw value again.
+        for (const std::uint16_t raw : {std::uint16_t{35}, std::uint16_t{884}, std::uint16_t{65535}}) {
+            CHECK(encoded(p, static_cast<double>(raw) / std::round(1.0 / scale)) == Regs{raw});
+        }
+    }
+    // Other scales multiply, as before.
+    const fc::PointDef half = point(PointType::int16, WordOrder::high_first, ByteOrder::big, 0.5, -20.0);
+    CHECK(std::get<double>(pts::decode(half, Regs{41})) == 0.5);
+}
+
+TEST_CASE("codec: a format template shows the point's registers") {
+    fc::PointDef v = point(PointType::uint16);
+    v.format = fc::PointFormat::text;
+    v.count = 4;
+    v.format_text = "V{0}.{1}.{2}.{3}";
+    CHECK(v.width() == 4);
+    CHECK(std::get<std::string>(pts::decode(v, Regs{3, 0, 1, 884})) == "V3.0.1.884");
+    v.format_text = "{1:hex}-{0} {{raw}}";
+    CHECK(std::get<std::string>(pts::decode(v, Regs{65535, 0x0A20, 0, 0})) == "0x0A20-65535 {raw}");
+    v.type = PointType::int16;
+    CHECK(std::get<std::string>(pts::decode(v, Regs{65535, 0x0A20, 0, 0})) == "0x0A20--1 {raw}");
+}
+
+TEST_CASE("codec: enum_other shows the code it stands for as {value} or {value:hex}") {
+    fc::PointDef m = point(PointType::uint16);
+    m.labels = {{0x0A10, "XEG-16"}};
+    CHECK(pts::enum_text(m, 0x0A10) == "XEG-16");
+    CHECK(pts::enum_text(m, 0x0A99).empty());  // no enum_other: the caller shows the code
+    m.enum_other = "unknown ({value:hex})";
+    CHECK(pts::enum_text(m, 0x0A99) == "unknown (0x0A99)");
+    m.enum_other = "code {value}";
+    CHECK(pts::enum_text(m, 0x0A99) == "code 2713");
+    m.enum_other = "unknown";
+    CHECK(pts::enum_text(m, 7) == "unknown");
+    fc::PointDef wide = point(PointType::uint32);
+    wide.labels = {{1, "one"}};
+    wide.enum_other = "{value:hex}";
+    CHECK(pts::enum_text(wide, 0x10000) == "0x00010000");
+}
+
 TEST_CASE("codec: strings, two ASCII characters a register, NULs trimmed") {
     fc::PointDef s = point(PointType::string);
     s.count = 3;
