@@ -179,21 +179,4 @@ std::optional<std::uint8_t> max_current_in(const RegisterImage& image) {
     return static_cast<std::uint8_t>(*v);
 }
 
-std::optional<std::string> version_in(const RegisterImage& image) {
-    std::string text;
-    for (std::uint16_t i = 0; i < ext_firmware_registers; ++i) {
-        const auto v = image.value(Table::input, static_cast<std::uint16_t>(ext_firmware + i));
-        if (!v) {
-            return std::nullopt;
-        }
-        for (const auto c : {static_cast<char>(*v >> 8), static_cast<char>(*v & 0xFF)}) {
-            if (c == '\0') {
-                return text;
-            }
-            text.push_back(c);
-        }
-    }
-    return text;
-}
-
 }  // namespace fieldbridge::engine::wtec_image

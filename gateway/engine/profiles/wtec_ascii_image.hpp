@@ -45,8 +45,6 @@ void store_release(RegisterImage& image, const protocol::wtec::ReleaseParams& pa
 [[nodiscard]] std::optional<protocol::wtec::HomingParams> homing_in(const RegisterImage& image);
 /// R's max current when read and not 0 (the current at 100 % force).
 [[nodiscard]] std::optional<std::uint8_t> max_current_in(const RegisterImage& image);
-/// The `A` text from the extension block; nullopt until read.
-[[nodiscard]] std::optional<std::string> version_in(const RegisterImage& image);
 /// A pair of extension registers, high word first.
 [[nodiscard]] std::optional<std::uint32_t> u32_in(const RegisterImage& image, std::uint16_t address);
 

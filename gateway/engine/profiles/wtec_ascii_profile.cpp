@@ -151,7 +151,9 @@ std::uint16_t wtec_uniform_init_state(std::uint8_t code) noexcept {
 }
 
 WtecAsciiProfile::WtecAsciiProfile(const ProfileOptions& options)
-    : map_(*builtin_register_map(DeviceType::wtec_ascii, options)), options_(options) {
+    : map_(*builtin_register_map(DeviceType::wtec_ascii, options)),
+      options_(options),
+      state_(builtin_state_points(DeviceType::wtec_ascii, options)) {
     if (!options.wtec_stroke || *options.wtec_stroke == 0) {
         throw ProfileError("wtec-ascii device: `stroke` (encoder counts from the homing point to 100 %) is "
                            "required and must be positive; read N's target at both ends to find it");
@@ -428,34 +430,9 @@ bool WtecAsciiProfile::in_motion(const RegisterImage& image) const {
     return wtec_in_motion(image);
 }
 
-DecodedState WtecAsciiProfile::decode_state(const RegisterImage& image) const {
-    DecodedState state;
-    decode_wtec_uniform(image, state);
-    if (const auto raw = wtec_image::u32_in(image, ext_position)) {
-        state.fields.push_back({"position_counts", std::int64_t{static_cast<std::int32_t>(*raw)}, "count"});
-    }
-    const auto input = [&image](std::uint16_t a) { return image.value(Table::input, a); };
-    if (const auto v = input(ext_current)) {
-        state.fields.push_back({"current", std::int64_t{*v}, ""});
-    }
-    if (const auto v = input(ext_enabled)) {
-        state.fields.push_back({"enabled", *v != 0, ""});
-    }
-    if (const auto v = input(ext_grip_code)) {
-        state.fields.push_back({"grip_code", std::int64_t{*v}, ""});
-    }
-    if (const auto v = input(ext_homing_code)) {
-        state.fields.push_back({"homing_code", std::int64_t{*v}, ""});
-    }
-    if (const auto text = wtec_image::version_in(image)) {
-        state.fields.push_back({"firmware", *text, ""});
-    }
-    return state;
-}
+DecodedState WtecAsciiProfile::decode_state(const RegisterImage& image) const { return state_.decode(image); }
 
-std::vector<Alarm> WtecAsciiProfile::alarms(const RegisterImage& image) const {
-    return wtec_uniform_alarms(image, image.value(Table::input, ext_homing_code));
-}
+std::vector<Alarm> WtecAsciiProfile::alarms(const RegisterImage& image) const { return state_.alarms(image); }
 
 OperationSet WtecAsciiProfile::operations() const { return wtec_operations(); }
 

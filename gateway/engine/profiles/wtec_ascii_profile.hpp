@@ -28,6 +28,7 @@
 #include <optional>
 #include <vector>
 
+#include "engine/profiles/point_state.hpp"
 #include "engine/profiles/device_profile.hpp"
 #include "engine/profiles/register_map.hpp"
 
@@ -92,6 +93,8 @@ private:
     RegisterMap map_;
     ProfileOptions options_;
     std::uint32_t stroke_ = 0;
+    /// The state fields and alarms: the points of the definition (wtec-ascii.yaml).
+    PointState state_;
 };
 
 }  // namespace fieldbridge::engine

@@ -94,83 +94,9 @@ std::span<const FieldSetter> wtec_field_setters() noexcept {
     return setters;
 }
 
-std::string_view wtec_init_state_name(std::uint16_t value) noexcept {
-    switch (value) {
-        case wtec_reg::init_not_done: return "not_initialized";
-        case wtec_reg::init_done: return "initialized";
-        case wtec_reg::init_failed: return "failed";
-        case wtec_reg::init_running: return "initializing";
-        default: return "unknown";
-    }
-}
-
-std::string_view wtec_grip_state_name(std::uint16_t value) noexcept {
-    switch (value) {
-        case wtec_reg::grip_moving: return "moving";
-        case wtec_reg::grip_reached: return "reached";
-        case wtec_reg::grip_gripped: return "gripped";
-        case wtec_reg::grip_released:
-        case wtec_reg::grip_released_hex: return "motor_released";
-        default: return "unknown";
-    }
-}
-
 bool wtec_in_motion(const RegisterImage& image) {
     return image.value(Table::holding, wtec_reg::grip_state) == wtec_reg::grip_moving ||
            image.value(Table::holding, wtec_reg::init_state) == wtec_reg::init_running;
-}
-
-void decode_wtec_uniform(const RegisterImage& image, DecodedState& state) {
-    using namespace wtec_reg;
-    const auto value = [&image](std::uint16_t address) { return image.value(Table::holding, address); };
-    if (const auto v = value(init_state)) {
-        state.fields.push_back({"init_state", std::string{wtec_init_state_name(*v)}, ""});
-        state.fields.push_back({"init_state_code", std::int64_t{*v}, ""});
-    }
-    if (const auto v = value(grip_state)) {
-        state.fields.push_back({"grip_state", std::string{wtec_grip_state_name(*v)}, ""});
-        state.fields.push_back({"grip_state_code", std::int64_t{*v}, ""});
-    }
-    if (const auto v = value(instant_position)) {
-        state.fields.push_back({"position_pct", std::int64_t{*v}, "%"});
-    }
-    if (const auto v = value(position)) {
-        state.fields.push_back({"target_pct", std::int64_t{*v}, "%"});
-    }
-    if (const auto v = value(force)) {
-        state.fields.push_back({"force_pct", std::int64_t{*v}, "%"});
-    }
-    if (const auto v = value(speed)) {
-        state.fields.push_back({"speed_pct", std::int64_t{*v}, "%"});
-    }
-    if (const auto v = value(estop)) {
-        state.fields.push_back({"estop", *v != 0, ""});
-    }
-    if (const auto v = value(init_direction)) {
-        const std::string name = *v == direction_open ? "open" : *v == direction_close ? "close" : "unknown";
-        state.fields.push_back({"init_direction", name, ""});
-    }
-}
-
-std::vector<Alarm> wtec_uniform_alarms(const RegisterImage& image, std::optional<std::uint16_t> raw_homing_code) {
-    using namespace wtec_reg;
-    std::vector<Alarm> out;
-    if (image.value(Table::holding, init_state) == init_failed) {
-        // Seed 003 command 11: 03 is "超过极限位置" (beyond the limit position),
-        // shown as failed (2) in the uniform register.
-        if (raw_homing_code == 0x03) {
-            out.push_back(Alarm{"beyond_limit", "homing went beyond the limit position; check the stroke and initialise again",
-                                Severity::error, "holding 0x0200"});
-        } else {
-            out.push_back(Alarm{"init_failed", "initialisation (homing) failed; remove any obstacle and initialise again",
-                                Severity::error, "holding 0x0200"});
-        }
-    }
-    if (image.value(Table::holding, estop) == 1) {
-        out.push_back(Alarm{"emergency_stop", "emergency stop latched; only initialising (0x0100 = 1) releases it",
-                            Severity::critical, "holding 0x0102"});
-    }
-    return out;
 }
 
 }  // namespace fieldbridge::engine

@@ -91,21 +91,7 @@ namespace fieldbridge::engine {
 /// force_pct (force), speed_pct (speed).
 [[nodiscard]] std::span<const FieldSetter> wtec_field_setters() noexcept;
 
-/// Seed 003 table 2.4: "not_initialized", "initialized", "failed", "initializing".
-[[nodiscard]] std::string_view wtec_init_state_name(std::uint16_t value) noexcept;
-/// Seed 003 table 2.8: "moving", "reached", "gripped", "motor_released".
-[[nodiscard]] std::string_view wtec_grip_state_name(std::uint16_t value) noexcept;
-
 /// Rule 5: moving (grip state 0) or homing (init state 9).
 [[nodiscard]] bool wtec_in_motion(const RegisterImage& image);
-
-/// Fields of the uniform registers present in the image (the ASCII view's; the RTU
-/// mode's are the points of config/devices/wtec-rtu.yaml).
-void decode_wtec_uniform(const RegisterImage& image, DecodedState& state);
-
-/// Init failed (2; "beyond_limit" when @p raw_homing_code is the ASCII code 03) and
-/// e-stop latched.
-[[nodiscard]] std::vector<Alarm> wtec_uniform_alarms(const RegisterImage& image,
-                                                     std::optional<std::uint16_t> raw_homing_code);
 
 }  // namespace fieldbridge::engine

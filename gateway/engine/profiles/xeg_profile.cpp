@@ -17,8 +17,6 @@ using protocol::ExceptionCode;
 // Seed 001 §3 "Data Allocation Table".
 constexpr std::uint16_t di_first = 0x0000;   // IN1-IN6, START, (unused)
 constexpr std::uint16_t do_first = 0x0010;   // POS HOLD BUSY ALM1 ALM2 CHK1 CHK2 CHK3
-constexpr std::uint16_t do_alm1 = 0x0013;
-constexpr std::uint16_t do_alm2 = 0x0014;
 constexpr std::uint16_t actual_position = 0x0300;   // 0.01 mm
 constexpr std::uint16_t status = 0x0301;     // 0-7, §3.2
 constexpr std::uint16_t firmware = 0x0303;   // 0x0303-0x0306, §3.2
@@ -46,9 +44,6 @@ constexpr std::array<XegModelLimits, 5> model_table{{
     {0x0A30, "XEG-48", 4800, 8000, 2000, 50},
     {0x0A40, "XEG-64", 6400, 10000, 2000, 40},
 }};
-
-constexpr std::array<std::string_view, 8> di_names{"in1", "in2", "in3", "in4", "in5", "in6", "start", "di7"};
-constexpr std::array<std::string_view, 8> do_names{"pos", "hold", "busy", "alm1", "alm2", "chk1", "chk2", "chk3"};
 
 [[nodiscard]] WireFunctions xeg_wire_functions() {
     // Seed 001 §4.1 function code table; FC06 is accepted northbound and translated.
@@ -138,17 +133,12 @@ std::string_view xeg_exception_status_text(std::uint8_t code) noexcept {
     }
 }
 
-std::string_view xeg_status_name(std::uint16_t value) noexcept {
-    constexpr std::array<std::string_view, 8> names{"idle",           "working",    "positioned", "holding",
-                                                    "position_alarm", "move_alarm", "home_alarm", "emergency_stop"};
-    return value < names.size() ? names[value] : "unknown";
-}
-
 OperationSet xeg_operations() { return OperationSet{"xeg", xeg_operation_table()}; }
 
 XegProfile::XegProfile(const ProfileOptions& options)
     : ModbusProfile(builtin_register_map(DeviceType::hiwin_xeg, options), xeg_wire_functions(), options,
-                    WordOrder::high_first) {}
+                    WordOrder::high_first),
+      state_(builtin_state_points(DeviceType::hiwin_xeg, options)) {}
 
 std::optional<ExceptionCode> XegProfile::check_value(const RegisterDef& /*def*/, std::uint16_t unit_address,
                                                      std::int64_t value, const RegisterImage& image) const {
@@ -227,60 +217,8 @@ bool XegProfile::in_motion(const RegisterImage& image) const {
     return image.value(Table::input, status) == status_working;
 }
 
-DecodedState XegProfile::decode_state(const RegisterImage& image) const {
-    DecodedState state;
-    if (const auto s = image.value(Table::input, status)) {
-        state.fields.push_back({"status", std::string{xeg_status_name(*s)}, ""});
-        state.fields.push_back({"status_code", std::int64_t{*s}, ""});
-    }
-    if (const auto p = image.value(Table::input, actual_position)) {
-        state.fields.push_back({"position_mm", static_cast<double>(*p) / 100.0, "mm"});
-    }
-    if (const auto m = image.value(Table::holding, model)) {
-        const auto l = xeg_model_limits(*m);
-        state.fields.push_back({"model", l ? std::string{l->name} : "unknown (" + hex_word(*m) + ")", ""});
-    }
-    std::array<std::optional<std::uint16_t>, 4> fw{};
-    for (std::size_t i = 0; i < fw.size(); ++i) {
-        fw[i] = image.value(Table::input, static_cast<std::uint16_t>(firmware + i));
-    }
-    if (fw[0] && fw[1] && fw[2] && fw[3]) {
-        // Seed 001 §3.2 / Appendix 1: 3, 0, 1, 884 reads "V3.0.1.884".
-        state.fields.push_back({"firmware",
-                                "V" + std::to_string(*fw[0]) + "." + std::to_string(*fw[1]) + "." +
-                                    std::to_string(*fw[2]) + "." + std::to_string(*fw[3]),
-                                ""});
-    }
-    for (std::size_t i = 0; i < 8; ++i) {
-        if (const auto v = image.value(Table::discrete_inputs, static_cast<std::uint16_t>(di_first + i))) {
-            state.fields.push_back({"di_" + std::string{di_names[i]}, *v != 0, ""});
-        }
-        if (const auto v = image.value(Table::discrete_inputs, static_cast<std::uint16_t>(do_first + i))) {
-            state.fields.push_back({"do_" + std::string{do_names[i]}, *v != 0, ""});
-        }
-    }
-    return state;
-}
+DecodedState XegProfile::decode_state(const RegisterImage& image) const { return state_.decode(image); }
 
-std::vector<Alarm> XegProfile::alarms(const RegisterImage& image) const {
-    std::vector<Alarm> out;
-    if (const auto s = image.value(Table::input, status); s && *s >= 4 && *s <= 7) {
-        // Seed 001 §3.2: status 4-7 are alarms; 7 is the emergency-stop circuit.
-        constexpr std::array<std::string_view, 4> texts{
-            "position failure: the gripper did not reach the position",
-            "move alarm: the motion was obstructed or failed",
-            "home reset failure: initialise (reset 0x0610) again after clearing the obstacle",
-            "emergency stop: the emergency circuit is open; close it and reset"};
-        out.push_back(Alarm{std::string{xeg_status_name(*s)}, std::string{texts[*s - 4]},
-                            *s == 7 ? Severity::critical : Severity::error, "input 0x0301"});
-    }
-    if (image.value(Table::discrete_inputs, do_alm1) == 1) {
-        out.push_back(Alarm{"alm1", "alarm output ALM1 is on", Severity::error, "discrete input 0x0013"});
-    }
-    if (image.value(Table::discrete_inputs, do_alm2) == 1) {
-        out.push_back(Alarm{"alm2", "alarm output ALM2 is on", Severity::error, "discrete input 0x0014"});
-    }
-    return out;
-}
+std::vector<Alarm> XegProfile::alarms(const RegisterImage& image) const { return state_.alarms(image); }
 
 }  // namespace fieldbridge::engine

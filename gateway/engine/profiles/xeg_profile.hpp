@@ -8,13 +8,15 @@
 /// stop, 0x0630-0x0632 move, 0x0640-0x0646 expert (the model is writable, limited
 /// to the §3.3 codes). The controller knows FC02, 03,
 /// 04, 07 and 10 only (§4.1): a client's FC06 goes out as FC16 with one register.
-/// Move and expert values are checked against the model's ranges (§3.4.2).
+/// Move and expert values are checked against the model's ranges (§3.4.2). The MQTT
+/// state and alarms are the points of the definition (config/devices/hiwin-xeg.yaml).
 
 #include <cstdint>
 #include <optional>
 #include <string_view>
 
 #include "engine/profiles/modbus_profile.hpp"
+#include "engine/profiles/point_state.hpp"
 
 namespace fieldbridge::engine {
 
@@ -44,10 +46,6 @@ struct XegModelLimits {
 /// Seed 001 §4.2.4: the text of an FC07 exception status code.
 [[nodiscard]] std::string_view xeg_exception_status_text(std::uint8_t code) noexcept;
 
-/// "idle", "working", "positioned", "holding", "position_alarm", "move_alarm",
-/// "home_alarm", "emergency_stop" for status 0-7 (seed 001 §3.2); "unknown" else.
-[[nodiscard]] std::string_view xeg_status_name(std::uint16_t status) noexcept;
-
 /// The MQTT operations (docs/mqtt.md, "hiwin-xeg"): reset, stop, move, expert,
 /// trigger (seed 001 §3.4).
 [[nodiscard]] OperationSet xeg_operations();
@@ -76,6 +74,9 @@ private:
                              ApplyResult& result) const override;
     void apply_other(const protocol::Request& sent, const protocol::Response& reply, RegisterImage& image,
                      TimePoint now, ApplyResult& result) const override;
+
+    /// The state fields and alarms: the points of the definition (hiwin-xeg.yaml).
+    PointState state_;
 };
 
 }  // namespace fieldbridge::engine

@@ -516,6 +516,43 @@ TEST_CASE("wtec-rtu's state is points of its definition: the fields and the alar
     CHECK(wtec->points.alarms.at(1).severity == fieldbridge::core::AlarmSeverity::critical);
 }
 
+TEST_CASE("hiwin-xeg's state is points of its definition: the fields and the alarms of docs/mqtt.md") {
+    const DeviceDefinition* xeg = builtin_definition(DeviceType::hiwin_xeg);
+    REQUIRE(xeg != nullptr);
+    std::vector<std::string> names;
+    for (const auto& point : xeg->points.points) names.push_back(point.name);
+    CHECK(names == std::vector<std::string>{"status",  "position_mm", "model",   "firmware", "di_in1",  "do_pos",
+                                            "di_in2",  "do_hold",     "di_in3",  "do_busy",  "di_in4",  "do_alm1",
+                                            "di_in5",  "do_alm2",     "di_in6",  "do_chk1",  "di_start", "do_chk2",
+                                            "di_di7", "do_chk3"});
+    const auto& model = xeg->points.points.at(2);
+    CHECK(model.enum_other == "unknown ({value:hex})");
+    CHECK_FALSE(model.enum_code);
+    const auto& firmware = xeg->points.points.at(3);
+    CHECK(firmware.format == fieldbridge::core::PointFormat::text);
+    CHECK(firmware.format_text == "V{0}.{1}.{2}.{3}");
+    CHECK(firmware.width() == 4);
+    std::vector<std::string> alarms;
+    for (const auto& alarm : xeg->points.alarms) alarms.push_back(alarm.name + " " + alarm.source);
+    CHECK(alarms == std::vector<std::string>{"position_alarm input 0x0301", "move_alarm input 0x0301",
+                                             "home_alarm input 0x0301", "emergency_stop input 0x0301",
+                                             "alm1 discrete input 0x0013", "alm2 discrete input 0x0014"});
+}
+
+TEST_CASE("wtec-ascii's state is points of its definition: the fields and the alarms of docs/mqtt.md") {
+    const DeviceDefinition* wtec = builtin_definition(DeviceType::wtec_ascii);
+    REQUIRE(wtec != nullptr);
+    std::vector<std::string> names;
+    for (const auto& point : wtec->points.points) names.push_back(point.name);
+    CHECK(names == std::vector<std::string>{"init_state", "grip_state", "position_pct", "target_pct", "force_pct",
+                                            "speed_pct", "estop", "init_direction", "position_counts", "current",
+                                            "enabled", "grip_code", "homing_code", "firmware"});
+    std::vector<std::string> alarms;
+    for (const auto& alarm : wtec->points.alarms) alarms.push_back(alarm.name + " " + alarm.point);
+    CHECK(alarms == std::vector<std::string>{"init_failed homing_code", "beyond_limit homing_code",
+                                             "emergency_stop estop"});
+}
+
 TEST_CASE("an operator's copy with points: replaces the compiled-in state; one without keeps it") {
     const fieldbridge::test::TempDir dir("fb-definitions");
     const auto copy = dir.path() / "devices" / "excd203mb.yaml";

@@ -423,6 +423,55 @@ TEST_CASE("wtec-ascii: reads answered from the image after the commands") {
     CHECK(alarms[0].code == "beyond_limit");
 }
 
+TEST_CASE("wtec-ascii: the state and alarms of the definition's points are those the profile made in C++") {
+    // Every field, in order, with its value and unit, as decode_wtec_uniform() and
+    // WtecAsciiProfile::decode_state() made them before wtec-ascii.yaml named them as
+    // points (and docs/mqtt.md lists).
+    View v;
+    const auto now = t0();
+    const auto put = [&](Table table, std::uint16_t address, std::vector<std::uint16_t> values) {
+        v.image.update(table, address, values, now);
+    };
+    put(Table::holding, 0x0200, {2});
+    put(Table::holding, 0x0202, {0x11});
+    put(Table::holding, 0x0204, {48});
+    put(Table::holding, 0x0102, {1, 80, 100, 50});
+    put(Table::holding, 0x0300, {2});
+    put(Table::input, 0x1000, {0xFFFF, 0xFFFD, 3, 1, 5, 2});
+    put(Table::input, 0x102A, {0x4373, 0x7465, 0x7020, 0x5B41, 0x5D31, 0x2E36, 0x3200, 0x0000});  // "Cstep [A]1.62"
+    using F = fe::Field;
+    const std::vector<F> expected{
+        F{"init_state", std::string{"failed"}, ""},   F{"init_state_code", std::int64_t{2}, ""},
+        F{"grip_state", std::string{"motor_released"}, ""}, F{"grip_state_code", std::int64_t{17}, ""},
+        F{"position_pct", std::int64_t{48}, "%"},     F{"target_pct", std::int64_t{50}, "%"},
+        F{"force_pct", std::int64_t{80}, "%"},        F{"speed_pct", std::int64_t{100}, "%"},
+        F{"estop", true, ""},                         F{"init_direction", std::string{"close"}, ""},
+        F{"position_counts", std::int64_t{-3}, "count"}, F{"current", std::int64_t{3}, ""},
+        F{"enabled", true, ""},                       F{"grip_code", std::int64_t{5}, ""},
+        F{"homing_code", std::int64_t{2}, ""},        F{"firmware", std::string{"Cstep [A]1.62"}, ""},
+    };
+    CHECK(v.profile.decode_state(v.image).fields == expected);
+
+    const fe::Alarm estop{"emergency_stop", "emergency stop latched; only initialising (0x0100 = 1) releases it",
+                          fe::Severity::critical, "holding 0x0102"};
+    CHECK(v.profile.alarms(v.image) ==
+          std::vector<fe::Alarm>{{"init_failed", "initialisation (homing) failed; remove any obstacle and initialise again",
+                                  fe::Severity::error, "holding 0x0200"},
+                                 estop});
+    put(Table::input, 0x1005, {3});  // the hook writes 0x0200 = 2 for it too
+    CHECK(v.profile.alarms(v.image) ==
+          std::vector<fe::Alarm>{{"beyond_limit",
+                                  "homing went beyond the limit position; check the stroke and initialise again",
+                                  fe::Severity::error, "holding 0x0200"},
+                                 estop});
+    put(Table::input, 0x1005, {1});
+    put(Table::holding, 0x0200, {1});
+    put(Table::holding, 0x0102, {0});
+    CHECK(v.profile.alarms(v.image).empty());
+    put(Table::holding, 0x0300, {7});
+    CHECK(field<std::string>(v.profile.decode_state(v.image), "init_direction") == "unknown");
+}
+
 TEST_CASE("wtec-ascii: the same gripper through the RTU profile and the ASCII view reads the same") {
     View ascii_view;
     ascii_view.polled();

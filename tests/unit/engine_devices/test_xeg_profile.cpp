@@ -247,6 +247,59 @@ TEST_CASE("xeg: applying replies (Appendix 1) and decoding the state") {
     CHECK(x.image.value(Table::input, 0x0300) == 2000);
 }
 
+TEST_CASE("xeg: the state and alarms of the definition's points are those the profile made in C++") {
+    // Every field, in order, with its value and unit, as XegProfile::decode_state()
+    // made them before hiwin-xeg.yaml named them as points (and docs/mqtt.md lists).
+    Xeg x;
+    const auto now = t0();
+    x.image.update(Table::input, 0x0300, std::vector<std::uint16_t>{35, 8}, now);  // 0.35 mm, status 8
+    x.image.update(Table::input, 0x0303, std::vector<std::uint16_t>{3, 0, 1, 884}, now);
+    x.image.update(Table::holding, 0x0600, std::vector<std::uint16_t>{0x0A99}, now);
+    x.image.update(Table::discrete_inputs, 0x0000, std::vector<std::uint16_t>{1, 0, 0, 0, 0, 0, 1, 0}, now);
+    x.image.update(Table::discrete_inputs, 0x0010, std::vector<std::uint16_t>{0, 0, 1, 0, 0, 0, 0, 1}, now);
+    using F = fe::Field;
+    const std::vector<F> expected{
+        F{"status", std::string{"unknown"}, ""},
+        F{"status_code", std::int64_t{8}, ""},
+        F{"position_mm", 0.35, "mm"},
+        F{"model", std::string{"unknown (0x0A99)"}, ""},
+        F{"firmware", std::string{"V3.0.1.884"}, ""},
+        F{"di_in1", true, ""},  F{"do_pos", false, ""},  F{"di_in2", false, ""},  F{"do_hold", false, ""},
+        F{"di_in3", false, ""}, F{"do_busy", true, ""},  F{"di_in4", false, ""},  F{"do_alm1", false, ""},
+        F{"di_in5", false, ""}, F{"do_alm2", false, ""}, F{"di_in6", false, ""},  F{"do_chk1", false, ""},
+        F{"di_start", true, ""}, F{"do_chk2", false, ""}, F{"di_di7", false, ""}, F{"do_chk3", true, ""},
+    };
+    CHECK(x.profile.decode_state(x.image).fields == expected);
+    // 0.01 mm: the decimal, for every register value (raw / 100, not raw * 0.01).
+    for (const std::uint16_t raw : {std::uint16_t{1}, std::uint16_t{35}, std::uint16_t{884}, std::uint16_t{6400},
+                                    std::uint16_t{65535}}) {
+        x.image.update(Table::input, 0x0300, std::vector<std::uint16_t>{raw}, now);
+        CHECK(field<double>(x.profile.decode_state(x.image), "position_mm") == static_cast<double>(raw) / 100.0);
+    }
+    x.model(xeg_16);
+    CHECK(field<std::string>(x.profile.decode_state(x.image), "model") == "XEG-16");
+    CHECK(x.profile.decode_state(x.image).find("model_code") == nullptr);
+
+    // The alarms, with their texts and sources.
+    x.image.update(Table::input, 0x0301, std::vector<std::uint16_t>{6}, now);
+    x.image.update(Table::discrete_inputs, 0x0013, std::vector<std::uint16_t>{1, 1}, now);
+    const std::vector<fe::Alarm> alarms{
+        {"home_alarm", "home reset failure: initialise (reset 0x0610) again after clearing the obstacle",
+         fe::Severity::error, "input 0x0301"},
+        {"alm1", "alarm output ALM1 is on", fe::Severity::error, "discrete input 0x0013"},
+        {"alm2", "alarm output ALM2 is on", fe::Severity::error, "discrete input 0x0014"},
+    };
+    CHECK(x.profile.alarms(x.image) == alarms);
+    const std::vector<std::pair<std::uint16_t, std::string>> texts{
+        {4, "position failure: the gripper did not reach the position"},
+        {5, "move alarm: the motion was obstructed or failed"},
+        {7, "emergency stop: the emergency circuit is open; close it and reset"}};
+    for (const auto& [status, text] : texts) {
+        x.image.update(Table::input, 0x0301, std::vector<std::uint16_t>{status}, now);
+        CHECK(x.profile.alarms(x.image).front().text == text);
+    }
+}
+
 TEST_CASE("xeg: acknowledged writes update the image; auto-reset registers read 0") {
     Xeg x;
     // FC06 0x0631 went out as FC16.
@@ -337,6 +390,5 @@ TEST_CASE("xeg: model limits table (§3.4.2)") {
     CHECK(l->force_min == 50);
     CHECK_FALSE(fe::xeg_model_limits(0x0A50).has_value());
     CHECK(fe::xeg_widest_limits().stroke == 6400);
-    CHECK(fe::xeg_status_name(8) == "unknown");
     CHECK(fe::make_profile(fe::DeviceType::hiwin_xeg, {})->type() == fe::DeviceType::hiwin_xeg);
 }
