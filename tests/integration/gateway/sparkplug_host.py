@@ -90,6 +90,12 @@ class Message:
     def metrics(self):
         return self.payload["metrics"] if self.payload and "metrics" in self.payload else []
 
+    @property
+    def historical(self):
+        """True for data replayed from the node's offline buffer: every metric is_historical
+        (the data a cell made before the node's first connection is such a replay)."""
+        return bool(self.metrics) and all(m.get("is_historical") for m in self.metrics)
+
     def metric(self, name):
         """The metric named @p name (births carry names), None when absent."""
         for metric in self.metrics:
@@ -105,8 +111,9 @@ class Message:
             shown = [(m["name"] if m["name"] is not None else m["alias"], m["value"]) for m in self.metrics]
             if len(shown) > 8:
                 shown = shown[:8] + ["... %d metrics" % len(shown)]
-            return "<%s %s seq=%s qos=%d retained=%d %s>" % (self.kind, self.device or "", self.seq, self.qos,
-                                                             self.retained, shown)
+            return "<%s %s seq=%s qos=%d retained=%d%s %s>" % (self.kind, self.device or "", self.seq, self.qos,
+                                                               self.retained, " historical" if self.historical else "",
+                                                               shown)
         return "<%s qos=%d retained=%d %r%s>" % (self.topic, self.qos, self.retained, self.raw[:120],
                                                  " error: " + self.error if self.error else "")
 
