@@ -327,6 +327,13 @@ const fieldbridge::core::RegisterDef& row_named(const std::vector<fieldbridge::c
 constexpr std::string_view excd_abs_row =
     "{name: abs, address: 0x0100, width: 2, access: write, motion: true, min: -8300000, max: 8300000}";
 
+/// The names of a definition's points, in its order (the MQTT fields).
+std::vector<std::string> point_names(const DeviceDefinition& definition) {
+    std::vector<std::string> names;
+    for (const auto& point : definition.points.points) names.push_back(point.name);
+    return names;
+}
+
 }  // namespace
 
 TEST_CASE("every built-in type's compiled-in definition is its shipped file in config/devices") {
@@ -482,10 +489,8 @@ TEST_CASE("behaviour: takes registers, and points of them for its state; not blo
 TEST_CASE("excd203mb's state is points of its definition: the fields and the alarm of docs/mqtt.md") {
     const DeviceDefinition* excd = builtin_definition(DeviceType::excd203mb);
     REQUIRE(excd != nullptr);
-    std::vector<std::string> names;
-    for (const auto& point : excd->points.points) names.push_back(point.name);
-    CHECK(names == std::vector<std::string>{"position", "encoder", "busy", "inputs", "outputs", "sensor",
-                                            "alarm_code", "version"});
+    CHECK(point_names(*excd) == std::vector<std::string>{"position", "encoder", "busy", "inputs", "outputs",
+                                                         "sensor", "alarm_code", "version"});
     const auto& busy = excd->points.points.at(2);
     CHECK(busy.invert);
     CHECK(busy.bit == 0);
@@ -501,10 +506,9 @@ TEST_CASE("excd203mb's state is points of its definition: the fields and the ala
 TEST_CASE("wtec-rtu's state is points of its definition: the fields and the alarms of docs/mqtt.md") {
     const DeviceDefinition* wtec = builtin_definition(DeviceType::wtec_rtu);
     REQUIRE(wtec != nullptr);
-    std::vector<std::string> names;
-    for (const auto& point : wtec->points.points) names.push_back(point.name);
-    CHECK(names == std::vector<std::string>{"init_state", "grip_state", "position_pct", "target_pct", "force_pct",
-                                            "speed_pct", "estop", "init_direction", "saved", "device_id"});
+    CHECK(point_names(*wtec) == std::vector<std::string>{"init_state", "grip_state", "position_pct", "target_pct",
+                                                         "force_pct", "speed_pct", "estop", "init_direction", "saved",
+                                                         "device_id"});
     const auto& grip = wtec->points.points.at(1);
     CHECK(grip.enum_other == "unknown");
     CHECK(grip.labels.size() == 5);  // 11 and 0x11 are both motor_released
@@ -519,12 +523,10 @@ TEST_CASE("wtec-rtu's state is points of its definition: the fields and the alar
 TEST_CASE("hiwin-xeg's state is points of its definition: the fields and the alarms of docs/mqtt.md") {
     const DeviceDefinition* xeg = builtin_definition(DeviceType::hiwin_xeg);
     REQUIRE(xeg != nullptr);
-    std::vector<std::string> names;
-    for (const auto& point : xeg->points.points) names.push_back(point.name);
-    CHECK(names == std::vector<std::string>{"status",  "position_mm", "model",   "firmware", "di_in1",  "do_pos",
-                                            "di_in2",  "do_hold",     "di_in3",  "do_busy",  "di_in4",  "do_alm1",
-                                            "di_in5",  "do_alm2",     "di_in6",  "do_chk1",  "di_start", "do_chk2",
-                                            "di_di7", "do_chk3"});
+    CHECK(point_names(*xeg) == std::vector<std::string>{"status", "position_mm", "model", "firmware", "di_in1",
+                                                        "do_pos", "di_in2", "do_hold", "di_in3", "do_busy", "di_in4",
+                                                        "do_alm1", "di_in5", "do_alm2", "di_in6", "do_chk1",
+                                                        "di_start", "do_chk2", "di_di7", "do_chk3"});
     const auto& model = xeg->points.points.at(2);
     CHECK(model.enum_other == "unknown ({value:hex})");
     CHECK_FALSE(model.enum_code);
@@ -542,11 +544,10 @@ TEST_CASE("hiwin-xeg's state is points of its definition: the fields and the ala
 TEST_CASE("wtec-ascii's state is points of its definition: the fields and the alarms of docs/mqtt.md") {
     const DeviceDefinition* wtec = builtin_definition(DeviceType::wtec_ascii);
     REQUIRE(wtec != nullptr);
-    std::vector<std::string> names;
-    for (const auto& point : wtec->points.points) names.push_back(point.name);
-    CHECK(names == std::vector<std::string>{"init_state", "grip_state", "position_pct", "target_pct", "force_pct",
-                                            "speed_pct", "estop", "init_direction", "position_counts", "current",
-                                            "enabled", "grip_code", "homing_code", "firmware"});
+    CHECK(point_names(*wtec) == std::vector<std::string>{"init_state", "grip_state", "position_pct", "target_pct",
+                                                         "force_pct", "speed_pct", "estop", "init_direction",
+                                                         "position_counts", "current", "enabled", "grip_code",
+                                                         "homing_code", "firmware"});
     std::vector<std::string> alarms;
     for (const auto& alarm : wtec->points.alarms) alarms.push_back(alarm.name + " " + alarm.point);
     CHECK(alarms == std::vector<std::string>{"init_failed homing_code", "beyond_limit homing_code",
