@@ -56,6 +56,20 @@ void check_enum_other(const RawPoint& point, DiagnosticSink& sink) {
     }
 }
 
+/// A point shown as a text (`format: hex`, a template) shows its registers as they
+/// are: nothing to scale or label. @p format names the format in the messages.
+void refuse_number_keys(const RawPoint& point, std::string_view format, DiagnosticSink& sink) {
+    const std::string with = "a point with " + std::string(format);
+    for (const auto* key : {&point.scale, &point.offset, &point.min, &point.max, &point.deadband}) {
+        if (key->has_value()) {
+            sink.error(*key, with + " shows its registers as a text; remove this key (or the format)");
+        }
+    }
+    if (!point.labels.absent()) {
+        sink.error(point.labels, with + " shows its registers as a text, not a label; remove enum (or the format)");
+    }
+}
+
 /// `format:` as a template ("V{0}.{1}.{2}.{3}"): `count` registers of int16 / uint16,
 /// each placeholder one of them, read-only and unscaled.
 void check_text_format(const RawPoint& point, PointType type, DiagnosticSink& sink) {
@@ -83,15 +97,7 @@ void check_text_format(const RawPoint& point, PointType type, DiagnosticSink& si
                                      "to {" + std::to_string(count > 0 ? count - 1 : 0) +
                                      "} ({0:hex}: 0x and four digits)");
     }
-    for (const auto* key : {&point.scale, &point.offset, &point.min, &point.max, &point.deadband}) {
-        if (key->has_value()) {
-            sink.error(*key, "a point with a format template shows its registers as a text; remove this key");
-        }
-    }
-    if (!point.labels.absent()) {
-        sink.error(point.labels, "a point with a format template shows its registers as a text, not a label; "
-                                 "remove enum (or the format)");
-    }
+    refuse_number_keys(point, "a format template", sink);
     if (point.writable.value_or(false)) {
         sink.error(point.writable, "a point with a format template is read-only; expected writable: false");
     }
@@ -235,17 +241,7 @@ bool check_point(const RawPoint& point, DiagnosticSink& sink) {
             sink.error(point.format, "format: hex applies only to integer points (this point is " + type_text(type) +
                                          "); remove it");
         } else {
-            // The text shows the registers as they are: nothing to scale, label or write.
-            for (const auto* key : {&point.scale, &point.offset, &point.min, &point.max, &point.deadband}) {
-                if (key->has_value()) {
-                    sink.error(*key, "a point with format: hex shows its registers as a text; remove this key "
-                                     "(or the format)");
-                }
-            }
-            if (!point.labels.absent()) {
-                sink.error(point.labels, "a point with format: hex shows its registers as a text, not a label; "
-                                         "remove enum (or the format)");
-            }
+            refuse_number_keys(point, "format: hex", sink);
             if (point.writable.value_or(false)) {
                 sink.error(point.writable, "a point with format: hex is read-only; expected writable: false (or "
                                            "remove the format to write it as a number)");
