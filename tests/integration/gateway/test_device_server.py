@@ -117,15 +117,22 @@ class DeviceServerCell(gatewaylib.CellTestCase):
                       % (self.server_a.port, self.server_a.port), self.gateway.text())
 
     def test_a_write_goes_before_queued_reads(self):
-        self.start_servers_and_gateway()
+        # What is measured is the order of the queue, not the line's timeout: 1 s, so
+        # that a stall of the Python relay on a loaded machine (CI once saw one past
+        # 200 ms under qemu-user) does not fail a read.
+        self.start_servers_and_gateway(meter_timeout="1s")
         stop = threading.Event()
         reads = []
+        failures = []
 
         def load():
             client = self.client()
             while not stop.is_set():
                 started = time.monotonic()
-                ok = self.meter(0, client) is not None
+                reply = client.read_holding_registers(0, count=1, slave=METER)
+                ok = not reply.isError()
+                if not ok:
+                    failures.append(repr(reply))
                 reads.append((time.monotonic() - started, ok))
 
         workers = [threading.Thread(target=load) for _ in range(4)]
@@ -143,7 +150,8 @@ class DeviceServerCell(gatewaylib.CellTestCase):
             stop.set()
             for worker in workers:
                 worker.join(10)
-        self.assertTrue(all(ok for _, ok in reads), "a read failed under load")
+        self.assertEqual(failures, [], "reads failed under load")
+        self.assertTrue(all(ok for _, ok in reads))
         read_times = sorted(t for t, _ in reads)
         median_read = read_times[len(read_times) // 2]
         print("under load: %d reads, median %.1f ms; writes %s ms"
