@@ -11,18 +11,10 @@ namespace fieldbridge::app {
 namespace mqtt = northbound::mqtt;
 
 mqtt::PahoOptions sparkplug_paho_options(const config::SparkplugConfig& config) {
-    mqtt::PahoOptions o;
-    o.uri = config.servers.front();
-    o.servers = config.servers;
-    o.client_id = config.client_id;
-    o.username = config.username;
-    o.password = config.password;
-    o.tls = config.uses_tls();
-    o.tls_files = config.tls;
+    mqtt::PahoOptions o = mqtt::connection_options(config.servers, config);
     // Sparkplug 3.0: MQTT 3.1.1 with a clean session (tck-id-principles-persistence-clean-session-311).
     o.version = config::MqttVersion::v3_1_1;
     o.clean_session = true;
-    o.keep_alive = std::chrono::duration_cast<std::chrono::seconds>(config.keep_alive);
     // The real will (NDEATH with the connection's bdSeq) is set before every CONNECT.
     o.will = mqtt::Message{};
     // A DCMD is small (sparkplug::CommandLimits): larger payloads are cut and refused.

@@ -57,16 +57,8 @@ void release_free_memory() noexcept {
 }  // namespace
 
 PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic) {
-    PahoOptions o;
-    o.uri = config.uris.front();
-    o.servers = config.uris;
-    o.client_id = config.client_id;
-    o.username = config.username;
-    o.password = config.password;
-    o.tls = config.uses_tls();
-    o.tls_files = config.tls;
+    PahoOptions o = connection_options(config.uris, config);
     o.version = config.version;
-    o.keep_alive = std::chrono::duration_cast<std::chrono::seconds>(config.keep_alive);
     o.clean_session = config.clean_session;
     o.will = Message{will_topic, "offline", config.qos, true};
     o.max_inbound_messages = config.max_queued_commands;

@@ -55,6 +55,24 @@ struct PahoOptions {
 /// larger still gets its `too_large` result.
 inline constexpr std::uint32_t packet_headroom_bytes = 64 * 1024 + 1024;
 
+/// What every broker connection of the gateway takes from its config section
+/// (config::MqttConfig, config::SparkplugConfig): the brokers to walk (@p servers, the
+/// first one the client's), client id, credentials, TLS and keep-alive. The rest
+/// (version, session, will, inbound bounds) is each northbound's own.
+template <typename Section>
+[[nodiscard]] PahoOptions connection_options(const std::vector<std::string>& servers, const Section& section) {
+    PahoOptions o;
+    o.uri = servers.front();
+    o.servers = servers;
+    o.client_id = section.client_id;
+    o.username = section.username;
+    o.password = section.password;
+    o.tls = section.uses_tls();
+    o.tls_files = section.tls;
+    o.keep_alive = std::chrono::duration_cast<std::chrono::seconds>(section.keep_alive);
+    return o;
+}
+
 /// The options of @p config with the will on @p will_topic.
 [[nodiscard]] PahoOptions paho_options(const config::MqttConfig& config, const std::string& will_topic);
 
