@@ -107,16 +107,6 @@ std::string ready_line(const std::string& log) {
     return "?";
 }
 
-/// Waits (bounded) until the daemon's log holds @p text.
-bool wait_for_log(const bench::DaemonProcess& daemon, const std::string& text, std::chrono::seconds timeout) {
-    const auto deadline = Clock::now() + timeout;
-    while (daemon.log_text().find(text) == std::string::npos) {
-        if (Clock::now() >= deadline) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds{20});
-    }
-    return true;
-}
-
 struct Usage {
     long rss = 0;
     long pss = 0;
@@ -190,7 +180,7 @@ void run_one(const std::string& daemon_binary, const Shape& shape, bool metrics,
     bench::DaemonProcess daemon(daemon_binary, config_path, sim.dir() / "fieldbridge.log");
     const char* mqtt_state = "MQTT off";
     if (!broker_uri.empty()) {
-        mqtt_state = wait_for_log(daemon, "MQTT: connected", std::chrono::seconds{10}) ? "MQTT connected"
+        mqtt_state = daemon.wait_for_log("MQTT: connected", std::chrono::seconds{10}) ? "MQTT connected"
                                                                                       : "MQTT NOT connected";
     }
 

@@ -54,7 +54,6 @@
 #include <exception>
 #include <fstream>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -110,24 +109,6 @@ struct Options {
         return std::find(parts.begin(), parts.end(), part) != parts.end();
     }
 };
-
-/// The daemon's warnings and errors so far (the first few): a benchmark figure that
-/// looks wrong usually has its reason there (timeouts, a device gone offline).
-void print_warnings(const std::string& log, const char* when) {
-    std::istringstream lines(log);
-    std::string line;
-    int shown = 0;
-    int total = 0;
-    while (std::getline(lines, line)) {
-        if (line.find("[warning]") == std::string::npos && line.find("[error]") == std::string::npos) continue;
-        ++total;
-        if (shown < 5) {
-            std::printf("daemon log %s: %s\n", when, line.c_str());
-            ++shown;
-        }
-    }
-    if (total > shown) std::printf("daemon log %s: ... %d warnings/errors in all\n", when, total);
-}
 
 
 /// line-b's devices: one XEG (unit 2) or four generic devices (units 2-5), every
@@ -249,7 +230,7 @@ void run_cache(const Options& options, const test::SimProcess& sim, const bench:
     std::printf("summary: cache reads flat out (32 clients): %.0f reads/s, p99 %.0f us; line-a %+.1f requests/s "
                 "caused by them\n",
                 cached_rate, cached.p99_us, static_cast<double>(load_requests) / cached.seconds - idle_rate);
-    print_warnings(daemon.log_text(), "during (1)");
+    daemon.print_warnings("during (1)");
 
     // ---- 1b: paced at the target rate, null server and daemon alternated ------------
     constexpr double paced_rate = 50'000.0;
@@ -290,7 +271,7 @@ void run_cache(const Options& options, const test::SimProcess& sim, const bench:
     std::printf("summary: cache reads paced at 50000/s, p99 from when due (target < 1000 us), median of %d runs: "
                 "daemon %.0f us, null server %.0f us\n",
                 options.paced_runs, bench::median_of(daemon_p99), bench::median_of(null_p99));
-    print_warnings(daemon.log_text(), "during (1b)");
+    daemon.print_warnings("during (1b)");
 }
 
 struct LineLoad {
@@ -504,7 +485,7 @@ int run(const Options& options) {
                 static_cast<unsigned long long>(bus_counter(sim, "line-a", "gap_violations")),
                 static_cast<unsigned long long>(bus_counter(sim, "line-b", "gap_violations")),
                 sim.stats()["buses"]["line-b"].value("min_silence_us", nlohmann::json("?")).dump().c_str());
-    print_warnings(daemon.log_text(), "at the end");
+    daemon.print_warnings("at the end");
 
     const int daemon_status = daemon.terminate();
     if (daemon_status != 0) {

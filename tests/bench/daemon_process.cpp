@@ -7,7 +7,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -97,6 +99,31 @@ int DaemonProcess::terminate(std::chrono::milliseconds timeout) {
 std::string DaemonProcess::log_text() const {
     std::ifstream in(log_);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+bool DaemonProcess::wait_for_log(const std::string& text, std::chrono::milliseconds timeout) const {
+    const auto deadline = Clock::now() + timeout;
+    while (log_text().find(text) == std::string::npos) {
+        if (Clock::now() >= deadline) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds{20});
+    }
+    return true;
+}
+
+void DaemonProcess::print_warnings(const std::string& when) const {
+    std::istringstream lines(log_text());
+    std::string line;
+    int shown = 0;
+    int total = 0;
+    while (std::getline(lines, line)) {
+        if (line.find("[warning]") == std::string::npos && line.find("[error]") == std::string::npos) continue;
+        ++total;
+        if (shown < 8) {
+            std::printf("daemon log %s: %s\n", when.c_str(), line.c_str());
+            ++shown;
+        }
+    }
+    if (total > shown) std::printf("daemon log %s: ... %d warnings/errors in all\n", when.c_str(), total);
 }
 
 }  // namespace fieldbridge::bench

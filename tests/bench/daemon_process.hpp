@@ -39,6 +39,12 @@ public:
     /// SIGTERM, bounded wait, SIGKILL; the exit status or -1 when killed. Idempotent.
     int terminate(std::chrono::milliseconds timeout = std::chrono::seconds{10});
     [[nodiscard]] std::string log_text() const;
+    /// Waits (bounded) until the log holds @p text; false when it did not in time.
+    [[nodiscard]] bool wait_for_log(const std::string& text, std::chrono::milliseconds timeout) const;
+    /// Prints the log's warnings and errors so far (the first eight, and how many in
+    /// all), each line prefixed with @p when: a figure that looks wrong usually has its
+    /// reason there (timeouts, a device gone offline).
+    void print_warnings(const std::string& when) const;
 
 private:
     /// A "Name:   123 kB" field of /proc/<pid>/@p file, in KiB; 0 when unreadable.
