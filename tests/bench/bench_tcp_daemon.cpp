@@ -111,37 +111,6 @@ struct Options {
 };
 
 
-/// line-b's devices: one XEG (unit 2) or four generic devices (units 2-5), every
-/// read to the line.
-std::string direct_devices(const LoadShape& shape) {
-    if (shape.kind() == LoadShape::Kind::xeg) {
-        return R"(      - name: xeg-direct
-        type: hiwin-xeg
-        address: 2
-        unit_id: 2
-        max_age: 0ms
-        queue_limit: 64
-        poll: { fast: 60min, slow: 60min, motion: 60min }
-)";
-    }
-    std::string devices;
-    for (std::size_t d = 0; d < shape.devices(); ++d) {
-        // One block covering every address the shape reads (0-100) and the write's
-        // register; read once at start, then only on demand.
-        devices += fmt::format(R"(      - name: generic-{0}
-        type: modbus
-        address: {0}
-        unit_id: {1}
-        max_age: 0ms
-        queue_limit: 64
-        blocks:
-          - {{ table: holding, address: 0, count: 104, period: 1h, writable: true }}
-)",
-                               shape.bus_address(d), 2 + d);
-    }
-    return devices;
-}
-
 std::string daemon_yaml(const Options& options, std::uint16_t port, std::uint16_t metrics_port,
                         const std::string& line_a, const std::string& line_b) {
     std::string cached_line;
@@ -177,7 +146,7 @@ lines:
     turnaround: 0ms
     devices:
 {})",
-                       port, metrics_port, cached_line, line_b, options.baud, direct_devices(options.shape));
+                       port, metrics_port, cached_line, line_b, options.baud, options.shape.daemon_devices(2));
 }
 
 std::uint64_t bus_counter(const test::SimProcess& sim, const char* bus, const char* name) {

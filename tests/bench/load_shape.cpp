@@ -1,5 +1,7 @@
 #include "load_shape.hpp"
 
+#include <fmt/format.h>
+
 #include <stdexcept>
 
 namespace fieldbridge::bench {
@@ -38,6 +40,36 @@ ShapeRead LoadShape::read(std::uint64_t n) const noexcept {
 std::string LoadShape::sim_devices() const {
     if (kind_ == Kind::xeg) return "hiwin-xeg@2";
     return "modbus@1,modbus@2,modbus@3,modbus@4";
+}
+
+std::string LoadShape::daemon_devices(std::uint8_t first_unit) const {
+    if (kind_ == Kind::xeg) {
+        return fmt::format(R"(      - name: xeg-direct
+        type: hiwin-xeg
+        address: {}
+        unit_id: {}
+        max_age: 0ms
+        queue_limit: 64
+        poll: {{ fast: 60min, slow: 60min, motion: 60min }}
+)",
+                           bus_address(0), first_unit);
+    }
+    std::string yaml;
+    for (std::size_t d = 0; d < devices(); ++d) {
+        // Registers 0-103: the reads' 0-100 and the write's 0x10; read once at start,
+        // then only on demand.
+        yaml += fmt::format(R"(      - name: generic-{0}
+        type: modbus
+        address: {0}
+        unit_id: {1}
+        max_age: 0ms
+        queue_limit: 64
+        blocks:
+          - {{ table: holding, address: 0, count: 104, period: 1h, writable: true }}
+)",
+                            bus_address(d), first_unit + d);
+    }
+    return yaml;
 }
 
 }  // namespace fieldbridge::bench

@@ -43,6 +43,12 @@ public:
     [[nodiscard]] ShapeRead read(std::uint64_t n) const noexcept;
     /// The simulator's devices for one bus: "hiwin-xeg@2" / "modbus@1,modbus@2,...".
     [[nodiscard]] std::string sim_devices() const;
+    /// The daemon's side of the same devices: entries of a line's `devices:` list (YAML,
+    /// indented for it), Modbus TCP units from @p first_unit, every read to the line
+    /// (max_age 0), a queue for 16 readers and the writes, no polling to speak of: one
+    /// XEG `xeg-direct`, or `generic-<address>` with one block over every register the
+    /// shape reads or writes.
+    [[nodiscard]] std::string daemon_devices(std::uint8_t first_unit) const;
     /// The write a latency measurement sends: FC06 to this holding register (the XEG
     /// profile turns it into FC16), and its frame sizes on the line.
     [[nodiscard]] std::uint16_t write_register() const noexcept { return kind_ == Kind::xeg ? 0x0631 : 0x0010; }

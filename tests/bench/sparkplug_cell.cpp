@@ -81,18 +81,7 @@ mqtt: {{ enabled: true, uri: "{}" }}
         }
     }
     yaml += fmt::format("  - name: line-e\n    port: {}\n    baud: {}\n    devices:\n", sim.path("line-e"), baud);
-    for (std::size_t d = 0; d < shape.devices(); ++d) {
-        yaml += fmt::format(R"(      - name: generic-{0}
-        type: modbus
-        address: {0}
-        unit_id: {1}
-        max_age: 0ms
-        queue_limit: 64
-        blocks:
-          - {{ table: holding, address: 0, count: 104, period: 1h, writable: true }}
-)",
-                            shape.bus_address(d), line_e_first_unit + d);
-    }
+    yaml += shape.daemon_devices(line_e_first_unit);
     return yaml;
 }
 
