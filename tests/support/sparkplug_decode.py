@@ -207,7 +207,16 @@ def main(argv):
     if len(argv) < 2:
         print("usage: sparkplug_decode.py FILE... | --lines | --encode JSON", file=sys.stderr)
         return 2
-    decoder = SparkplugDecoder()
+    try:
+        decoder = SparkplugDecoder()
+    except FileNotFoundError:
+        print("sparkplug_decode.py: protoc is not installed: install Debian's protobuf-compiler "
+              "(deploy/install-deps.sh does)", file=sys.stderr)
+        return 1
+    except ModuleNotFoundError as e:
+        print("sparkplug_decode.py: %s cannot import %s (google.protobuf): install Debian's python3-protobuf (deploy/install-deps.sh "
+              "does) and run this with /usr/bin/python3" % (sys.executable, e.name), file=sys.stderr)
+        return 1
     if argv[1] == "--lines":
         _watch(decoder, sys.stdin, sys.stdout)
         return 0

@@ -68,7 +68,16 @@ def main():
     # A host's DCMD from encode() reads back.
     dcmd = decoder.decode(decoder.encode({"metrics": [{"alias": 2, "datatype": "Int16", "value": -5}]}))
     check(dcmd["metrics"][0]["value"] == -5, f"DCMD round trip: {dcmd}")
-    print("test_python_decoder: NBIRTH (16 metrics), DDATA, NDEATH decoded as encoded")
+    # Run as the README runs it, by an interpreter without python3-protobuf (-S: no
+    # site or dist packages, as a virtualenv's python3 first in PATH): it says what to
+    # install and which interpreter to use, and exits 1.
+    script = pathlib.Path(__file__).resolve().parents[2] / "support" / "sparkplug_decode.py"
+    bare = subprocess.run([sys.executable, "-S", str(script), "--lines"], input="", capture_output=True,
+                          text=True, timeout=60)
+    check(bare.returncode == 1 and "python3-protobuf" in bare.stderr and "/usr/bin/python3" in bare.stderr
+          and "Traceback" not in bare.stderr, f"without google.protobuf: {bare.returncode} {bare.stderr!r}")
+    print("test_python_decoder: NBIRTH (16 metrics), DDATA, NDEATH decoded as encoded; without python3-protobuf, "
+          "an error that says what to install")
 
 
 if __name__ == "__main__":
