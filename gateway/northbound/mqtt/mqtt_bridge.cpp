@@ -15,23 +15,6 @@ namespace fieldbridge::northbound::mqtt {
 using engine::LogLevel;
 using nlohmann::json;
 
-BridgeSettings bridge_settings(const config::MqttConfig& config) {
-    BridgeSettings s;
-    s.prefix = config.prefix;
-    s.qos = config.qos;
-    s.throttle.min_interval = config.min_interval;
-    s.throttle.heartbeat = config.heartbeat;
-    for (const auto& [field, band] : config.deadband) s.throttle.deadband.emplace(field, band);
-    s.diag_period = config.diag_period;
-    s.reconnect_initial = config.reconnect_backoff.initial;
-    s.reconnect_max = config.reconnect_backoff.max;
-    s.outbox_max_bytes = config.outbox_max_bytes;
-    s.outbox_capacity = config.outbox_max_messages;
-    s.max_command_bytes = config.max_command_bytes;
-    s.max_command_id_length = config.max_command_id_length;
-    return s;
-}
-
 class Bridge::Impl : public std::enable_shared_from_this<Impl> {
 public:
     Impl(asio::io_context& io, BridgeSettings settings, std::unique_ptr<Client> client, engine::LogSink log,
