@@ -214,8 +214,9 @@ def main(argv):
               "(deploy/install-deps.sh does)", file=sys.stderr)
         return 1
     except ModuleNotFoundError as e:
-        print("sparkplug_decode.py: %s cannot import %s (google.protobuf): install Debian's python3-protobuf (deploy/install-deps.sh "
-              "does) and run this with /usr/bin/python3" % (sys.executable, e.name), file=sys.stderr)
+        print("sparkplug_decode.py: %s cannot import %s (google.protobuf): install Debian's python3-protobuf "
+              "(deploy/install-deps.sh does) and run this with /usr/bin/python3" % (sys.executable, e.name),
+              file=sys.stderr)
         return 1
     if argv[1] == "--lines":
         _watch(decoder, sys.stdin, sys.stdout)

@@ -86,8 +86,8 @@ class DeviceServerCell(gatewaylib.CellTestCase):
             f.write(CONFIG.format(tcp_port=self.tcp_port, port_a=self.server_a.port, port_m=self.server_m.port,
                                   meter_timeout=meter_timeout, meter_extra=self.meter_extra))
 
-    def meter(self, register, client=None):
-        reply = (client or self.client_).read_holding_registers(register, count=1, slave=METER)
+    def meter(self, register):
+        reply = self.client_.read_holding_registers(register, count=1, slave=METER)
         return None if reply.isError() else reply.registers[0]
 
     def set_meter(self, register, value):
