@@ -180,8 +180,8 @@ void run_one(const std::string& daemon_binary, const Shape& shape, bool metrics,
     bench::DaemonProcess daemon(daemon_binary, config_path, sim.dir() / "fieldbridge.log");
     const char* mqtt_state = "MQTT off";
     if (!broker_uri.empty()) {
-        mqtt_state = daemon.wait_for_log("MQTT: connected", std::chrono::seconds{10}) ? "MQTT connected"
-                                                                                      : "MQTT NOT connected";
+        const bool connected = daemon.wait_for_log("MQTT: connected", std::chrono::seconds{10});
+        mqtt_state = connected ? "MQTT connected" : "MQTT NOT connected";
     }
 
     std::this_thread::sleep_for(duration<double>(seconds));  // every device's first reads

@@ -110,7 +110,6 @@ struct Options {
     }
 };
 
-
 std::string daemon_yaml(const Options& options, std::uint16_t port, std::uint16_t metrics_port,
                         const std::string& line_a, const std::string& line_b) {
     std::string cached_line;
